@@ -4,7 +4,6 @@
 mod common;
 
 use iceoryx2::prelude::*;
-use wingman_interfaces::layout::Wire;
 use wingman_interfaces::*;
 
 fn round_trip<M: Message + std::fmt::Debug>(node: &Node<ipc::Service>, value: &M) {

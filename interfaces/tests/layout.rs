@@ -194,7 +194,7 @@ fn plan_layout() {
             ("samples", 184),
         ],
     );
-    assert!(MAX_PLAN_SAMPLES >= 512);
+    const { assert!(MAX_PLAN_SAMPLES >= 512) };
 }
 
 #[test]

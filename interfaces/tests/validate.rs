@@ -4,7 +4,6 @@
 mod common;
 
 use proptest::prelude::*;
-use wingman_interfaces::layout::Wire;
 use wingman_interfaces::*;
 
 fn wrong_version<M: Message>(mut m: M, set: impl Fn(&mut M, u32)) {

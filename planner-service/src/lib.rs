@@ -1,1 +1,13 @@
-//! placeholder
+//! The wingman planning library: the numerical core (vehicle models, threat exposure,
+//! moving-threat estimation, re-plan timing, trajectory metrics), the scenario loader, and
+//! (in later modules) the hybrid planner and the planner service.
+//!
+//! One module per idea (see `../shared/STYLE.md`): every module is named for what it does.
+
+pub mod dynamics;
+pub mod estimation;
+pub mod logging;
+pub mod metrics;
+pub mod replan;
+pub mod scenario;
+pub mod threat;
