@@ -4,8 +4,10 @@
 //!
 //! One module per idea (see `../shared/STYLE.md`): every module is named for what it does.
 
+pub mod collocation;
 pub mod dynamics;
 pub mod estimation;
+pub mod lead;
 pub mod logging;
 pub mod metrics;
 pub mod replan;

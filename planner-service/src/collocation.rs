@@ -1,0 +1,5 @@
+//! Direct orthogonal collocation at Legendre–Gauss–Radau points (FORMULATION.md §4).
+
+pub mod lgr;
+
+pub use lgr::Lgr;
