@@ -4,12 +4,15 @@
 //!
 //! One module per idea (see `../shared/STYLE.md`): every module is named for what it does.
 
+pub mod clock;
 pub mod collocation;
 pub mod dynamics;
 pub mod estimation;
 pub mod lead;
 pub mod logging;
 pub mod metrics;
+pub mod problem;
 pub mod replan;
 pub mod scenario;
 pub mod threat;
+pub mod trajectory;

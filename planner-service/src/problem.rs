@@ -1,0 +1,408 @@
+//! The planning problem: everything one plan needs, in SI units and radians — the model,
+//! objective, vehicle limits, weights, initial state, targets, final state or lead, and the
+//! threat world (static layout plus moving threats with their current estimates). The
+//! offline `plan` command builds it from a scenario ([`Problem::from_scenario`]); the
+//! planner service builds it from its world model. Building it allocates; evaluating it
+//! ([`Problem::exposure`], …) does not.
+
+use wingman_interfaces::{MAX_TARGETS, Model, Objective};
+
+use crate::dynamics::{self, SpatialLimits, VehicleLimits};
+use crate::estimation::{self, Estimate, GaussMarkov, MovingThreat, Road};
+use crate::lead::{LeadError, LeadPath};
+use crate::scenario::{MovingThreatSpec, Scenario, StaticThreatSpec};
+use crate::threat::{self, Eval, Superquadric, ThreatLayout};
+
+/// A problem that cannot be planned: bad or inconsistent input.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ProblemError {
+    #[error("vehicle: {0}")]
+    Vehicle(#[from] dynamics::DynamicsError),
+    #[error("threat `{name}`: {source}")]
+    Threat {
+        name: String,
+        source: threat::ThreatError,
+    },
+    #[error("moving threat `{name}`: {source}")]
+    Moving {
+        name: String,
+        source: estimation::EstimationError,
+    },
+    #[error("lead: {0}")]
+    Lead(#[from] LeadError),
+    #[error("{0}")]
+    Invalid(String),
+}
+
+/// Cost weights (FORMULATION.md §3–4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CostWeights {
+    /// Time against running cost, in [0, 1].
+    pub alpha: f64,
+    /// Exposure against control effort, in [0, 1].
+    pub beta: f64,
+    /// Stiffness `s` of the exposure sigmoid.
+    pub stiffness: f64,
+}
+
+/// The threat world in the model's dimension.
+#[derive(Debug, Clone)]
+pub enum Threats {
+    /// 2-D: positions `[x, y]`.
+    Planar {
+        layout: ThreatLayout<2>,
+        moving: Vec<MovingThreat<2>>,
+    },
+    /// 3-D: positions `[x, y, z]`.
+    Spatial {
+        layout: ThreatLayout<3>,
+        moving: Vec<MovingThreat<3>>,
+    },
+}
+
+/// One plan's problem.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    pub model: Model,
+    pub objective: Objective,
+    pub limits: VehicleLimits,
+    pub weights: CostWeights,
+    /// Start time.
+    pub t0: f64,
+    /// Start state in model order, zero-padded to 7 (2-D: `x, y, psi`).
+    pub x0: [f64; 7],
+    /// Intermediate targets `[x, y, z]` (z = 0 in 2-D), in order.
+    pub targets: Vec<[f64; 3]>,
+    /// Final state (model order, zero-padded) for `FixedTime` and `MinTime`.
+    pub final_state: Option<[f64; 7]>,
+    /// Fixed final time for `FixedTime`.
+    pub final_time: Option<f64>,
+    /// The lead for `MinTimeRendezvous`.
+    pub lead: Option<LeadPath>,
+    pub threats: Threats,
+}
+
+impl Problem {
+    /// Number of states (3 or 7).
+    pub fn nx(&self) -> usize {
+        self.model.state_dim()
+    }
+
+    /// Number of controls (1 or 2).
+    pub fn nu(&self) -> usize {
+        self.model.control_dim()
+    }
+
+    /// Number of position coordinates (2 or 3).
+    pub fn dim(&self) -> usize {
+        self.model.position_dim()
+    }
+
+    /// Number of phases (one per leg: targets + 1).
+    pub fn phases(&self) -> usize {
+        self.targets.len() + 1
+    }
+
+    /// Index of the heading in the state vector.
+    pub fn heading_index(&self) -> usize {
+        match self.model {
+            Model::TwoD => 2,
+            Model::ThreeD => 4,
+        }
+    }
+
+    /// Exposure `E` at position `p` (`[x, y, z]`, z ignored in 2-D) and time `t`.
+    pub fn exposure(&self, p: &[f64; 3], t: f64) -> f64 {
+        match &self.threats {
+            Threats::Planar { layout, moving } => {
+                estimation::exposure_at(layout, moving, &[p[0], p[1]], t)
+            }
+            Threats::Spatial { layout, moving } => estimation::exposure_at(layout, moving, p, t),
+        }
+    }
+
+    /// Exposure with its gradient and Hessian in position (padded to 3; zeros for z in 2-D).
+    pub fn exposure_eval(&self, p: &[f64; 3], t: f64) -> Eval<3> {
+        match &self.threats {
+            Threats::Planar { layout, moving } => {
+                let e = estimation::exposure_eval_at(layout, moving, &[p[0], p[1]], t);
+                let mut out = Eval::<3>::zero();
+                out.value = e.value;
+                for i in 0..2 {
+                    out.grad[i] = e.grad[i];
+                    for j in 0..2 {
+                        out.hess[(i, j)] = e.hess[(i, j)];
+                    }
+                }
+                out
+            }
+            Threats::Spatial { layout, moving } => {
+                estimation::exposure_eval_at(layout, moving, p, t)
+            }
+        }
+    }
+
+    /// Whether any moving threat is in the world (exposure then depends on time).
+    pub fn has_moving_threats(&self) -> bool {
+        match &self.threats {
+            Threats::Planar { moving, .. } => !moving.is_empty(),
+            Threats::Spatial { moving, .. } => !moving.is_empty(),
+        }
+    }
+
+    /// The final position the plan must reach at time `t` (the final point, or the lead).
+    pub fn final_position_at(&self, t: f64) -> [f64; 3] {
+        match (&self.final_state, &self.lead) {
+            (Some(f), _) => [f[0], f[1], if self.dim() == 3 { f[2] } else { 0.0 }],
+            (None, Some(lead)) => lead.at(t).position,
+            (None, None) => [self.x0[0], self.x0[1], 0.0],
+        }
+    }
+
+    /// The take-off problem of a scenario: threats known at `start.time_s`, moving threats
+    /// from their initial estimate (no fixes), no events.
+    pub fn from_scenario(sc: &Scenario) -> Result<Problem, ProblemError> {
+        let v = &sc.vehicle;
+        let limits = match sc.model {
+            Model::TwoD => VehicleLimits::planar(v.speed_mps, v.turn_rate_max_rps)?,
+            Model::ThreeD => VehicleLimits::spatial(SpatialLimits {
+                speed: v.speed_mps,
+                gamma_max: v.gamma_max_rad,
+                nz_min: v.nz_min,
+                nz_max: v.nz_max,
+                mu_max: v.bank_max_rad,
+                nz_rate_max: v.nz_rate_max_per_s,
+                mu_rate_max: v.bank_rate_max_rps,
+                z_min: v.altitude_min_m,
+            })?,
+        };
+        let s = &sc.start;
+        let x0 = match sc.model {
+            Model::TwoD => [
+                s.position_m[0],
+                s.position_m[1],
+                s.heading_rad,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            ],
+            Model::ThreeD => [
+                s.position_m[0],
+                s.position_m[1],
+                s.position_m[2],
+                s.gamma_rad,
+                s.heading_rad,
+                1.0,
+                0.0,
+            ],
+        };
+        let final_state = sc.final_point.as_ref().map(|f| match sc.model {
+            Model::TwoD => [
+                f.position_m[0],
+                f.position_m[1],
+                f.heading_rad,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            ],
+            Model::ThreeD => [
+                f.position_m[0],
+                f.position_m[1],
+                f.position_m[2],
+                f.gamma_rad,
+                f.heading_rad,
+                f.nz,
+                f.mu_rad,
+            ],
+        });
+        let lead = match &sc.lead {
+            Some(l) => Some(LeadPath::new(&l.route_m, l.speed_mps, s.time_s)?),
+            None => None,
+        };
+        let statics: Vec<&StaticThreatSpec> = sc.known_static_threats().collect();
+        let movings: Vec<&MovingThreatSpec> = sc.known_moving_threats().collect();
+        let stiffness = sc.weights.stiffness;
+        let threats = match sc.model {
+            Model::TwoD => Threats::Planar {
+                layout: layout::<2>(&statics, stiffness)?,
+                moving: movings
+                    .iter()
+                    .map(|m| moving::<2>(m, s.time_s))
+                    .collect::<Result<_, _>>()?,
+            },
+            Model::ThreeD => Threats::Spatial {
+                layout: layout::<3>(&statics, stiffness)?,
+                moving: movings
+                    .iter()
+                    .map(|m| moving::<3>(m, s.time_s))
+                    .collect::<Result<_, _>>()?,
+            },
+        };
+        let problem = Problem {
+            model: sc.model,
+            objective: sc.objective,
+            limits,
+            weights: CostWeights {
+                alpha: sc.weights.alpha,
+                beta: sc.weights.beta,
+                stiffness,
+            },
+            t0: s.time_s,
+            x0,
+            targets: sc.targets.clone(),
+            final_state,
+            final_time: sc.final_point.as_ref().and_then(|f| f.time_s),
+            lead,
+            threats,
+        };
+        problem.validate()?;
+        Ok(problem)
+    }
+
+    /// Checks the problem is well posed: finite numbers, consistent objective, bounds that
+    /// admit the start and the end.
+    pub fn validate(&self) -> Result<(), ProblemError> {
+        let bad = |m: String| Err(ProblemError::Invalid(m));
+        if !self.t0.is_finite() || self.x0.iter().any(|v| !v.is_finite()) {
+            return bad("the start time and state must be finite".into());
+        }
+        if self.targets.len() > MAX_TARGETS {
+            return bad(format!(
+                "at most {MAX_TARGETS} targets, got {}",
+                self.targets.len()
+            ));
+        }
+        if self.targets.iter().flatten().any(|v| !v.is_finite()) {
+            return bad("targets must be finite".into());
+        }
+        let w = &self.weights;
+        if !((0.0..=1.0).contains(&w.alpha) && (0.0..=1.0).contains(&w.beta))
+            || !(w.stiffness > 0.0)
+        {
+            return bad("weights: alpha and beta must be in [0, 1], stiffness positive".into());
+        }
+        match self.objective {
+            Objective::FixedTime | Objective::MinTime => {
+                let Some(f) = &self.final_state else {
+                    return bad("a fixed-point objective needs a final state".into());
+                };
+                if f.iter().any(|v| !v.is_finite()) {
+                    return bad("the final state must be finite".into());
+                }
+                if self.objective == Objective::FixedTime {
+                    match self.final_time {
+                        Some(tf) if tf.is_finite() && tf > self.t0 => {}
+                        _ => {
+                            return bad(
+                                "a fixed-time objective needs a final time after the start".into()
+                            );
+                        }
+                    }
+                }
+            }
+            Objective::MinTimeRendezvous => {
+                if self.lead.is_none() {
+                    return bad("a rendezvous needs the lead's route".into());
+                }
+            }
+        }
+        if self.model == Model::ThreeD {
+            let l = &self.limits;
+            let x = &self.x0;
+            if x[2] < l.z_min
+                || x[3].abs() > l.gamma_max
+                || x[5] < l.nz_min
+                || x[5] > l.nz_max
+                || x[6].abs() > l.mu_max
+            {
+                return bad("the start state is outside the vehicle's bounds".into());
+            }
+            if self.targets.iter().any(|t| t[2] < l.z_min) {
+                return bad("a target is under the minimum altitude".into());
+            }
+        }
+        Ok(())
+    }
+}
+
+fn layout<const D: usize>(
+    specs: &[&StaticThreatSpec],
+    stiffness: f64,
+) -> Result<ThreatLayout<D>, ProblemError> {
+    let mut layout = ThreatLayout::<D>::new(stiffness).map_err(|source| ProblemError::Threat {
+        name: "(layout)".into(),
+        source,
+    })?;
+    for t in specs {
+        let err = |source| ProblemError::Threat {
+            name: t.name.clone(),
+            source,
+        };
+        let q = Superquadric::<D>::new(
+            std::array::from_fn(|i| t.center_m[i]),
+            std::array::from_fn(|i| t.axes_m[i]),
+            std::array::from_fn(|i| t.exponents[i]),
+            t.yaw_rad,
+        )
+        .map_err(err)?;
+        layout.push(q).map_err(err)?;
+    }
+    Ok(layout)
+}
+
+fn moving<const D: usize>(m: &MovingThreatSpec, t0: f64) -> Result<MovingThreat<D>, ProblemError> {
+    let err = |source| ProblemError::Moving {
+        name: m.name.clone(),
+        source,
+    };
+    let road: Vec<[f64; D]> = m
+        .road_m
+        .iter()
+        .map(|p| std::array::from_fn(|i| p[i]))
+        .collect();
+    let road = Road::<D>::new(&road).map_err(err)?;
+    let model = GaussMarkov::new(m.accel_tau_s, m.accel_sigma_mps2).map_err(err)?;
+    let estimate = Estimate::with_sigmas(
+        t0,
+        [m.initial_distance_m, m.initial_speed_mps, 0.0],
+        m.initial_sigma,
+    )
+    .map_err(err)?;
+    Ok(
+        MovingThreat::new(road, std::array::from_fn(|i| m.axes_m[i]), model, estimate)
+            .map_err(err)?
+            .with_appears_at(m.appears_at_s),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::BUNDLED;
+
+    #[test]
+    fn every_bundled_scenario_makes_a_problem() {
+        for (name, _) in BUNDLED {
+            let sc = crate::scenario::bundled(name).unwrap().unwrap();
+            let p = Problem::from_scenario(&sc).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(p.phases(), sc.targets.len() + 1);
+            assert!(p.exposure(&[p.x0[0], p.x0[1], p.x0[2]], p.t0).is_finite());
+        }
+    }
+
+    /// The exposure at the centre of a scenario threat is ~1 and far away ~0 (1e-9).
+    #[test]
+    fn exposure_dispatches_by_dimension() {
+        let sc = crate::scenario::bundled("2d-min-time-avoidable")
+            .unwrap()
+            .unwrap();
+        let p = Problem::from_scenario(&sc).unwrap();
+        let c = sc.threats[0].center_m;
+        assert!((p.exposure(&c, 0.0) - 1.0).abs() < 1e-9);
+        assert!(p.exposure(&[1e7, 1e7, 0.0], 0.0) < 1e-9);
+        let e = p.exposure_eval(&[c[0] + 100.0, c[1], 0.0], 0.0);
+        assert!(e.grad[2] == 0.0 && e.hess[(2, 2)] == 0.0);
+    }
+}
