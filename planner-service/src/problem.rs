@@ -142,6 +142,18 @@ impl Problem {
         }
     }
 
+    /// Exposure with derivatives in position *and* time, `z = (x, y, z, t)` (positions
+    /// padded to 3; the z entries are zero in 2-D). Static threats do not depend on time;
+    /// a moving threat's region does (its centre moves and its axis and exponent grow with
+    /// `sigma_d`). `d²F/dt²` of a moving threat is a central difference of its analytic
+    /// `dF/dt` (step 1e-3 s): it only enters the NLP's Hessian.
+    pub fn exposure_wt(&self, p: &[f64; 3], t: f64) -> ExposureWt {
+        match &self.threats {
+            Threats::Planar { layout, moving } => exposure_wt_in(layout, moving, &[p[0], p[1]], t),
+            Threats::Spatial { layout, moving } => exposure_wt_in(layout, moving, p, t),
+        }
+    }
+
     /// Whether any moving threat is in the world (exposure then depends on time).
     pub fn has_moving_threats(&self) -> bool {
         match &self.threats {
@@ -296,7 +308,7 @@ impl Problem {
                         Some(tf) if tf.is_finite() && tf > self.t0 => {}
                         _ => {
                             return bad(
-                                "a fixed-time objective needs a final time after the start".into()
+                                "a fixed-time objective needs a final time after the start".into(),
                             );
                         }
                     }
@@ -392,6 +404,59 @@ mod tests {
         }
     }
 
+    /// `exposure_wt` matches `exposure` and central differences of itself in (x, y, z, t)
+    /// on the moving-threat scenario (gradient 1e-5 relative to its scale, Hessian 1e-4).
+    #[test]
+    fn exposure_with_time_derivatives_matches_differences() {
+        let sc = crate::scenario::bundled("3d-min-time-moving-threat")
+            .unwrap()
+            .unwrap();
+        let p = Problem::from_scenario(&sc).unwrap();
+        let m = &sc.moving_threats[0];
+        // Near the moving threat's initial region, on its edge, where E varies fastest.
+        let (d0, road) = (m.initial_distance_m, &m.road_m);
+        let dir = [road[1][0] - road[0][0], road[1][1] - road[0][1]];
+        let len = dir[0].hypot(dir[1]);
+        let c = [
+            road[0][0] + d0 * dir[0] / len,
+            road[0][1] + d0 * dir[1] / len,
+        ];
+        for (k, t) in [10.0, 200.0, 500.0].into_iter().enumerate() {
+            let z = [c[0] + 9000.0 + 300.0 * k as f64, c[1] + 2000.0, 3000.0, t];
+            let e = p.exposure_wt(&[z[0], z[1], z[2]], z[3]);
+            assert!((e.value - p.exposure(&[z[0], z[1], z[2]], z[3])).abs() < 1e-15);
+            let steps = [1.0, 1.0, 1.0, 1e-2];
+            for i in 0..4 {
+                let shifted = |d: f64| {
+                    let mut y = z;
+                    y[i] += d;
+                    p.exposure_wt(&[y[0], y[1], y[2]], y[3])
+                };
+                let (a, b) = (shifted(steps[i]), shifted(-steps[i]));
+                let fd = (a.value - b.value) / (2.0 * steps[i]);
+                let scale = e.grad.iter().fold(1e-12f64, |m, v| m.max(v.abs()));
+                assert!(
+                    (fd - e.grad[i]).abs() < 1e-5 * scale,
+                    "t={t} grad[{i}]: {fd} vs {}",
+                    e.grad[i]
+                );
+                for j in 0..4 {
+                    let fd = (a.grad[j] - b.grad[j]) / (2.0 * steps[i]);
+                    let scale = e
+                        .hess
+                        .iter()
+                        .flatten()
+                        .fold(1e-12f64, |m, v| m.max(v.abs()));
+                    assert!(
+                        (fd - e.hess[i][j]).abs() < 1e-4 * scale,
+                        "t={t} hess[{i}][{j}]: {fd} vs {}",
+                        e.hess[i][j]
+                    );
+                }
+            }
+        }
+    }
+
     /// The exposure at the centre of a scenario threat is ~1 and far away ~0 (1e-9).
     #[test]
     fn exposure_dispatches_by_dimension() {
@@ -405,4 +470,75 @@ mod tests {
         let e = p.exposure_eval(&[c[0] + 100.0, c[1], 0.0], 0.0);
         assert!(e.grad[2] == 0.0 && e.hess[(2, 2)] == 0.0);
     }
+}
+
+/// Exposure `E` and its first and second derivatives in `z = (x, y, z, t)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExposureWt {
+    pub value: f64,
+    pub grad: [f64; 4],
+    pub hess: [[f64; 4]; 4],
+}
+
+/// Folds one threat's `F` (value, gradient and Hessian in `z`) into `E`, `P = prod eps`
+/// (the product rule of `threat::ExposureAcc`, in four variables).
+fn fold4(acc: &mut ExposureWt, prod: &mut f64, f: f64, df: &[f64; 4], d2f: &[[f64; 4]; 4], s: f64) {
+    let ed = threat::eps_derivs(f, s);
+    let de: [f64; 4] = std::array::from_fn(|k| ed.d1 * df[k]);
+    for i in 0..4 {
+        for j in 0..4 {
+            let d2eps = ed.d2 * df[i] * df[j] + ed.d1 * d2f[i][j];
+            acc.hess[i][j] =
+                ed.eps * acc.hess[i][j] + acc.grad[i] * de[j] + de[i] * acc.grad[j] - *prod * d2eps;
+        }
+    }
+    for k in 0..4 {
+        acc.grad[k] = ed.eps * acc.grad[k] - *prod * de[k];
+    }
+    acc.value += ed.one_minus * *prod;
+    *prod *= ed.eps;
+}
+
+fn exposure_wt_in<const D: usize>(
+    layout: &ThreatLayout<D>,
+    moving: &[MovingThreat<D>],
+    w: &[f64; D],
+    t: f64,
+) -> ExposureWt {
+    let s = layout.stiffness();
+    let mut acc = threat::ExposureAcc::<D>::new();
+    layout.fold_into(w, &mut acc);
+    let mut out = ExposureWt {
+        value: acc.e.value,
+        grad: [0.0; 4],
+        hess: [[0.0; 4]; 4],
+    };
+    for i in 0..D {
+        out.grad[i] = acc.e.grad[i];
+        for j in 0..D {
+            out.hess[i][j] = acc.e.hess[(i, j)];
+        }
+    }
+    let mut prod = acc.prod;
+    const STEP: f64 = 1e-3;
+    for m in moving {
+        if m.region_if_near(w, t, s).is_none() {
+            continue;
+        }
+        let e = m.eval(w, t);
+        let mut df = [0.0; 4];
+        let mut d2f = [[0.0; 4]; 4];
+        for i in 0..D {
+            df[i] = e.f.grad[i];
+            d2f[i][3] = e.dgrad_dt[i];
+            d2f[3][i] = e.dgrad_dt[i];
+            for j in 0..D {
+                d2f[i][j] = e.f.hess[(i, j)];
+            }
+        }
+        df[3] = e.df_dt;
+        d2f[3][3] = (m.eval(w, t + STEP).df_dt - m.eval(w, t - STEP).df_dt) / (2.0 * STEP);
+        fold4(&mut out, &mut prod, e.f.value, &df, &d2f, s);
+    }
+    out
 }
