@@ -1,10 +1,14 @@
 //! Direct orthogonal collocation at Legendre–Gauss–Radau points (FORMULATION.md §4): the
 //! LGR scheme, the mesh and node layout, and the sparse NLP of the transcription.
 
+pub mod export;
 pub mod lgr;
 pub mod mesh;
+pub mod solve;
 pub mod transcription;
 
+pub use export::{ExportSettings, export};
 pub use lgr::Lgr;
 pub use mesh::{Layout, Mesh};
+pub use solve::{NlpOutcome, NlpSettings, NlpStatus, PrimalDual, solve};
 pub use transcription::{Transcription, TranscriptionSettings};

@@ -82,6 +82,33 @@ impl Trajectory {
     }
 }
 
+impl Trajectory {
+    /// The samples as CSV in the judge's format (`../shared/reference/README.md`): a header
+    /// row, then `t,x,y,psi,u` (2-D) or `t,x,y,z,gamma,chi,nz,mu,u1,u2` (3-D), SI units and
+    /// radians, full precision.
+    pub fn to_csv(&self, model: wingman_interfaces::Model) -> String {
+        use std::fmt::Write;
+        let (header, nx, nu) = match model {
+            wingman_interfaces::Model::TwoD => ("t,x,y,psi,u", 3, 1),
+            wingman_interfaces::Model::ThreeD => ("t,x,y,z,gamma,chi,nz,mu,u1,u2", 7, 2),
+        };
+        let mut out = String::with_capacity(self.len() * 24 * (1 + nx + nu));
+        out.push_str(header);
+        out.push('\n');
+        for k in 0..self.len() {
+            let _ = write!(out, "{:?}", self.times[k]);
+            for v in &self.states[k][..nx] {
+                let _ = write!(out, ",{v:?}");
+            }
+            for v in &self.controls[k][..nu] {
+                let _ = write!(out, ",{v:?}");
+            }
+            out.push('\n');
+        }
+        out
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,442 @@
+//! Solving the transcription with pounce-rs (a pure-Rust port of Ipopt) under a deadline.
+//!
+//! Designed around the solver's known behaviour:
+//! - a bare application has no restoration phase, so [`install_restoration`] wires it;
+//! - its fall-back strategies re-solve silently with a fresh time budget, so they are off;
+//! - on a time or iteration limit it returns the *last* iterate, so the adapter keeps the
+//!   best iterate with the constraints within tolerance itself (checked every iteration in
+//!   the intermediate callback, which also enforces the caller's deadline);
+//! - a warm start from the previous primal and dual solution re-converges in a few
+//!   iterations (`warm_start_init_point`), used by re-plans.
+
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::time::Duration;
+
+use pounce_rs::pounce_nlp::live_iterate::with_current_user_iterate;
+use pounce_rs::pounce_common::options_list::OptionsList;
+use pounce_rs::{
+    AlgorithmMode, ApplicationReturnStatus, BoundsInfo, IndexStyle, IpoptApplication, IpoptCq, IpoptData, IterStats, NlpInfo,
+    Solution, SparsityRequest, StartingPoint, TNLP,
+};
+
+use super::transcription::Transcription;
+use crate::clock::Deadline;
+
+/// Settings of the NLP solve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NlpSettings {
+    /// Convergence tolerance (Ipopt `tol`, on the scaled problem).
+    pub tol: f64,
+    /// "Acceptable" tolerance and the number of acceptable iterations that stop the solve.
+    pub acceptable_tol: f64,
+    pub acceptable_iter: i32,
+    /// Iteration limit.
+    pub max_iter: i32,
+    /// Largest scaled constraint violation of an iterate that counts as feasible.
+    pub feasibility_tol: f64,
+    /// `monotone` or `adaptive`.
+    pub mu_strategy: &'static str,
+    /// Warm-start pushes (used with a warm start only).
+    pub warm_start_push: f64,
+    pub warm_start_mu_init: f64,
+    /// Ipopt print level (0: silent).
+    pub print_level: i32,
+    /// FERAL's own iterative refinement inside each back-solve (pounce already refines
+    /// the unreduced Newton system around it).
+    pub feral_refine: bool,
+    /// FERAL fill-reducing ordering (`auto`, `amd`, `amf`, `metis`, …).
+    pub feral_ordering: &'static str,
+    /// Keep every factorization on the calling thread: the KKT systems of one plan are
+    /// small, and rayon's fork/join hand-offs cost more than they save on two cores.
+    pub serial_factorization: bool,
+    /// FERAL's diagonal scaling (`auto`, `infnorm`, `mc64`, `identity`).
+    pub feral_scaling: &'static str,
+}
+
+impl Default for NlpSettings {
+    fn default() -> Self {
+        NlpSettings {
+            tol: 1e-7,
+            acceptable_tol: 1e-5,
+            acceptable_iter: 5,
+            max_iter: 300,
+            feasibility_tol: 1e-6,
+            mu_strategy: "monotone",
+            warm_start_push: 1e-6,
+            warm_start_mu_init: 1e-5,
+            print_level: 0,
+            feral_refine: false,
+            feral_ordering: "amf",
+            serial_factorization: true,
+            feral_scaling: "identity",
+        }
+    }
+}
+
+/// How the NLP ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NlpStatus {
+    /// Converged to `tol` (or to the acceptable level).
+    Converged,
+    /// Stopped by the iteration limit.
+    MaxIterations,
+    /// Stopped by the deadline.
+    MaxTime,
+    /// The solver failed (restoration failure, numerical trouble, …).
+    NumericalError,
+    /// The solver reports the constraints cannot be met.
+    Infeasible,
+}
+
+/// A primal-dual point, for warm starts.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PrimalDual {
+    pub x: Vec<f64>,
+    pub z_l: Vec<f64>,
+    pub z_u: Vec<f64>,
+    pub lambda: Vec<f64>,
+}
+
+/// The result of one NLP solve.
+#[derive(Debug, Clone)]
+pub struct NlpOutcome {
+    pub status: NlpStatus,
+    /// The solver's own return code.
+    pub return_status: ApplicationReturnStatus,
+    pub iterations: usize,
+    /// The scaled variables to use: the solution if converged, else the best feasible
+    /// iterate, else the last iterate.
+    pub x: Vec<f64>,
+    /// Whether `x` satisfies the constraints within `feasibility_tol`.
+    pub feasible: bool,
+    /// Largest scaled constraint or bound violation at `x`.
+    pub violation: f64,
+    /// Physical objective at `x`.
+    pub objective: f64,
+    /// Primal-dual solution for a warm start (when the solver finished normally).
+    pub warm: Option<PrimalDual>,
+    pub elapsed: Duration,
+}
+
+/// The TNLP adapter: owns the transcription during the solve.
+#[derive(Clone)]
+struct Adapter {
+    tr: Transcription,
+    start: PrimalDual,
+    warm: bool,
+    deadline: Deadline<'static>,
+    feasibility_tol: f64,
+    best: Vec<f64>,
+    best_objective: f64,
+    has_best: bool,
+    solution: Option<PrimalDual>,
+    iterations: usize,
+}
+
+impl TNLP for Adapter {
+    fn get_nlp_info(&mut self) -> Option<NlpInfo> {
+        Some(NlpInfo {
+            n: self.tr.n_vars() as i32,
+            m: self.tr.n_cons() as i32,
+            nnz_jac_g: self.tr.jac.len() as i32,
+            nnz_h_lag: self.tr.hess.len() as i32,
+            index_style: IndexStyle::C,
+        })
+    }
+
+    fn get_bounds_info(&mut self, b: BoundsInfo<'_>) -> bool {
+        b.x_l.copy_from_slice(&self.tr.x_lo);
+        b.x_u.copy_from_slice(&self.tr.x_hi);
+        b.g_l.copy_from_slice(&self.tr.g_lo);
+        b.g_u.copy_from_slice(&self.tr.g_hi);
+        true
+    }
+
+    fn get_starting_point(&mut self, sp: StartingPoint<'_>) -> bool {
+        sp.x.copy_from_slice(&self.start.x);
+        if self.warm {
+            if sp.init_z && self.start.z_l.len() == sp.z_l.len() {
+                sp.z_l.copy_from_slice(&self.start.z_l);
+                sp.z_u.copy_from_slice(&self.start.z_u);
+            }
+            if sp.init_lambda && self.start.lambda.len() == sp.lambda.len() {
+                sp.lambda.copy_from_slice(&self.start.lambda);
+            }
+        }
+        true
+    }
+
+    fn eval_f(&mut self, x: &[f64], _new_x: bool) -> Option<f64> {
+        let f = self.tr.objective(x);
+        f.is_finite().then_some(f)
+    }
+
+    fn eval_grad_f(&mut self, x: &[f64], _new_x: bool, grad: &mut [f64]) -> bool {
+        self.tr.gradient(x, grad);
+        grad.iter().all(|g| g.is_finite())
+    }
+
+    fn eval_g(&mut self, x: &[f64], _new_x: bool, g: &mut [f64]) -> bool {
+        self.tr.constraints(x, g);
+        g.iter().all(|v| v.is_finite())
+    }
+
+    fn eval_jac_g(&mut self, x: Option<&[f64]>, _new_x: bool, mode: SparsityRequest<'_>) -> bool {
+        match mode {
+            SparsityRequest::Structure { irow, jcol } => {
+                for (k, &(r, c)) in self.tr.jac.iter().enumerate() {
+                    irow[k] = r as i32;
+                    jcol[k] = c as i32;
+                }
+                true
+            }
+            SparsityRequest::Values { values } => {
+                let Some(x) = x else { return false };
+                self.tr.jacobian(x, values);
+                values.iter().all(|v| v.is_finite())
+            }
+        }
+    }
+
+    fn eval_h(
+        &mut self,
+        x: Option<&[f64]>,
+        _new_x: bool,
+        obj_factor: f64,
+        lambda: Option<&[f64]>,
+        _new_lambda: bool,
+        mode: SparsityRequest<'_>,
+    ) -> bool {
+        match mode {
+            SparsityRequest::Structure { irow, jcol } => {
+                for (k, &(r, c)) in self.tr.hess.iter().enumerate() {
+                    irow[k] = r as i32;
+                    jcol[k] = c as i32;
+                }
+                true
+            }
+            SparsityRequest::Values { values } => {
+                let (Some(x), Some(lambda)) = (x, lambda) else { return false };
+                self.tr.hessian(x, obj_factor, lambda, values);
+                values.iter().all(|v| v.is_finite())
+            }
+        }
+    }
+
+    fn finalize_solution(&mut self, sol: Solution<'_>, _d: &IpoptData, _q: &IpoptCq) {
+        self.solution = Some(PrimalDual {
+            x: sol.x.to_vec(),
+            z_l: sol.z_l.to_vec(),
+            z_u: sol.z_u.to_vec(),
+            lambda: sol.lambda.to_vec(),
+        });
+    }
+
+    fn wants_current_iterate(&self) -> bool {
+        true
+    }
+
+    fn intermediate_callback(&mut self, stats: IterStats, _d: &IpoptData, _q: &IpoptCq) -> bool {
+        self.iterations = stats.iter.max(0) as usize;
+        if stats.mode == AlgorithmMode::RegularMode
+            && stats.inf_pr <= self.feasibility_tol
+            && (!self.has_best || stats.obj_value < self.best_objective)
+        {
+            let best = &mut self.best;
+            let copied = with_current_user_iterate(|it| {
+                if it.x.len() == best.len() {
+                    best.copy_from_slice(&it.x);
+                    true
+                } else {
+                    false
+                }
+            });
+            if copied == Some(true) {
+                self.has_best = true;
+                self.best_objective = stats.obj_value;
+            }
+        }
+        !self.deadline.expired()
+    }
+}
+
+/// Wires the restoration phase into `app` (a bare application has none). Call after
+/// setting options: the provider copies them.
+fn install_restoration(app: &mut IpoptApplication) {
+    use pounce_rs::pounce_algorithm::application::{Ma57Config, default_backend_factory, feral_config_from_options};
+    use pounce_rs::pounce_restoration::resto_alg_builder::RestoAlgorithmBuilder;
+    use pounce_rs::pounce_restoration::resto_inner_solver::{
+        InnerBackendFactoryFactory, make_default_restoration_factory_provider,
+    };
+    let feral_cfg = feral_config_from_options(app.options());
+    let factory = move || -> InnerBackendFactoryFactory {
+        let cfg = feral_cfg.clone();
+        Box::new(move || default_backend_factory(cfg.clone(), Ma57Config::default()))
+    };
+    let provider = make_default_restoration_factory_provider(
+        RestoAlgorithmBuilder::new(),
+        app.algorithm_builder_from_options(),
+        factory,
+    );
+    app.set_restoration_factory_provider(provider);
+}
+
+/// An option the solver refused: a programming error in the settings.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("NLP option `{name}` refused: {reason}")]
+pub struct OptionError {
+    pub name: &'static str,
+    pub reason: String,
+}
+
+fn application(settings: &NlpSettings, warm: bool, budget: Duration) -> Result<IpoptApplication, OptionError> {
+    let mut app = IpoptApplication::new();
+    let _ = app.initialize();
+    let o = app.options_mut();
+    let num = |o: &mut OptionsList, name: &'static str, v: f64| {
+        o.set_numeric_value(name, v, true, false).map(|_| ()).map_err(|e| OptionError {
+            name,
+            reason: format!("{e:?}"),
+        })
+    };
+    num(o, "tol", settings.tol)?;
+    num(o, "acceptable_tol", settings.acceptable_tol)?;
+    num(o, "max_wall_time", budget.as_secs_f64().max(1e-3))?;
+    let int = |o: &mut OptionsList, name: &'static str, v: i32| {
+        o.set_integer_value(name, v, true, false).map(|_| ()).map_err(|e| OptionError {
+            name,
+            reason: format!("{e:?}"),
+        })
+    };
+    int(o, "max_iter", settings.max_iter)?;
+    int(o, "acceptable_iter", settings.acceptable_iter)?;
+    int(o, "print_level", settings.print_level)?;
+    let text = |o: &mut OptionsList, name: &'static str, v: &str| {
+        o.set_string_value(name, v, true, false).map(|_| ()).map_err(|e| OptionError {
+            name,
+            reason: format!("{e:?}"),
+        })
+    };
+    text(o, "hessian_approximation", "exact")?;
+    text(o, "mu_strategy", settings.mu_strategy)?;
+    text(o, "linear_solver", "feral")?;
+    let flag = |o: &mut OptionsList, name: &'static str, v: bool| {
+        o.set_bool_value(name, v, true, false).map(|_| ()).map_err(|e| OptionError {
+            name,
+            reason: format!("{e:?}"),
+        })
+    };
+    flag(o, "mu_strategy_fallback", false)?;
+    flag(o, "solve_quality_audit", false)?;
+    flag(o, "dual_divergence_retry", false)?;
+    flag(o, "honor_original_bounds", true)?;
+    flag(o, "feral_refine", settings.feral_refine)?;
+    text(o, "feral_ordering", settings.feral_ordering)?;
+    text(o, "feral_scaling", settings.feral_scaling)?;
+    if settings.print_level > 0 {
+        flag(o, "print_timing_statistics", true)?;
+    }
+    if settings.serial_factorization {
+        num(o, "feral_min_par_flops", 1e30)?;
+    }
+    if warm {
+        flag(o, "warm_start_init_point", true)?;
+        for name in [
+            "warm_start_bound_push",
+            "warm_start_bound_frac",
+            "warm_start_slack_bound_push",
+            "warm_start_slack_bound_frac",
+            "warm_start_mult_bound_push",
+        ] {
+            num(o, name, settings.warm_start_push)?;
+        }
+        num(o, "mu_init", settings.warm_start_mu_init)?;
+    }
+    install_restoration(&mut app);
+    Ok(app)
+}
+
+/// Solves `tr` from the scaled start `start` (with its duals when `warm_start`), stopping
+/// at `deadline`. Returns the transcription back with the outcome.
+pub fn solve(
+    tr: Transcription,
+    start: PrimalDual,
+    warm_start: bool,
+    settings: &NlpSettings,
+    deadline: Deadline<'static>,
+) -> Result<(Transcription, NlpOutcome), OptionError> {
+    let clock = deadline.clock();
+    let began = clock.now();
+    let n = tr.n_vars();
+    let mut app = application(settings, warm_start, deadline.remaining())?;
+    let adapter = Rc::new(RefCell::new(Adapter {
+        tr,
+        start,
+        warm: warm_start,
+        deadline,
+        feasibility_tol: settings.feasibility_tol,
+        best: vec![0.0; n],
+        best_objective: f64::INFINITY,
+        has_best: false,
+        solution: None,
+        iterations: 0,
+    }));
+    let dyn_adapter: Rc<RefCell<dyn TNLP>> = adapter.clone();
+    let return_status = app.optimize_tnlp(dyn_adapter);
+    let iterations = app.statistics().iteration_count.max(0) as usize;
+    drop(app);
+    let mut a = match Rc::try_unwrap(adapter) {
+        Ok(cell) => cell.into_inner(),
+        // The application let go of the problem when dropped; if it did not, copy it out.
+        Err(rc) => rc.borrow().clone(),
+    };
+    let status = match return_status {
+        ApplicationReturnStatus::SolveSucceeded | ApplicationReturnStatus::SolvedToAcceptableLevel => {
+            NlpStatus::Converged
+        }
+        ApplicationReturnStatus::MaximumIterationsExceeded => NlpStatus::MaxIterations,
+        ApplicationReturnStatus::MaximumWallTimeExceeded
+        | ApplicationReturnStatus::MaximumCpuTimeExceeded
+        | ApplicationReturnStatus::UserRequestedStop => NlpStatus::MaxTime,
+        ApplicationReturnStatus::InfeasibleProblemDetected => NlpStatus::Infeasible,
+        _ => NlpStatus::NumericalError,
+    };
+    let mut g = vec![0.0; a.tr.n_cons()];
+    let last = a.solution.as_ref().map(|s| s.x.clone());
+    // Prefer the converged solution; else the best feasible iterate; else the last.
+    let mut x = match (&last, status) {
+        (Some(x), NlpStatus::Converged) => x.clone(),
+        _ if a.has_best => a.best.clone(),
+        (Some(x), _) => x.clone(),
+        (None, _) => a.start.x.clone(),
+    };
+    let mut violation = a.tr.violation(&x, &mut g);
+    if status != NlpStatus::Converged && a.has_best {
+        if let Some(last) = &last {
+            // The last iterate may be feasible and better than the best seen in a callback.
+            let v_last = a.tr.violation(last, &mut g);
+            if v_last <= settings.feasibility_tol && a.tr.objective(last) < a.tr.objective(&x) {
+                x = last.clone();
+                violation = v_last;
+            }
+        }
+    }
+    let objective = a.tr.objective(&x) / a.tr.obj_scale;
+    let warm = match status {
+        NlpStatus::Converged => a.solution.take(),
+        _ => None,
+    };
+    let outcome = NlpOutcome {
+        status,
+        return_status,
+        iterations: iterations.max(a.iterations),
+        feasible: violation <= settings.feasibility_tol,
+        violation,
+        objective,
+        x,
+        warm,
+        elapsed: clock.now().saturating_sub(began),
+    };
+    Ok((a.tr, outcome))
+}
