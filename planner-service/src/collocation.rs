@@ -4,11 +4,13 @@
 pub mod export;
 pub mod lgr;
 pub mod mesh;
+pub mod refine;
 pub mod solve;
 pub mod transcription;
 
 pub use export::{ExportSettings, export};
 pub use lgr::Lgr;
 pub use mesh::{Layout, Mesh};
+pub use refine::{RefineSettings, interval_errors, refine};
 pub use solve::{NlpOutcome, NlpSettings, NlpStatus, PrimalDual, solve};
 pub use transcription::{Transcription, TranscriptionSettings};

@@ -15,4 +15,5 @@ pub mod problem;
 pub mod replan;
 pub mod scenario;
 pub mod threat;
+pub mod tracking;
 pub mod trajectory;

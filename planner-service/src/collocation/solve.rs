@@ -13,11 +13,11 @@ use std::cell::RefCell;
 use std::rc::Rc;
 use std::time::Duration;
 
-use pounce_rs::pounce_nlp::live_iterate::with_current_user_iterate;
 use pounce_rs::pounce_common::options_list::OptionsList;
+use pounce_rs::pounce_nlp::live_iterate::with_current_user_iterate;
 use pounce_rs::{
-    AlgorithmMode, ApplicationReturnStatus, BoundsInfo, IndexStyle, IpoptApplication, IpoptCq, IpoptData, IterStats, NlpInfo,
-    Solution, SparsityRequest, StartingPoint, TNLP,
+    AlgorithmMode, ApplicationReturnStatus, BoundsInfo, IndexStyle, IpoptApplication, IpoptCq,
+    IpoptData, IterStats, NlpInfo, Solution, SparsityRequest, StartingPoint, TNLP,
 };
 
 use super::transcription::Transcription;
@@ -52,6 +52,14 @@ pub struct NlpSettings {
     pub serial_factorization: bool,
     /// FERAL's diagonal scaling (`auto`, `infnorm`, `mc64`, `identity`).
     pub feral_scaling: &'static str,
+    /// FERAL static pivoting (force-accept small pivots instead of delaying them).
+    pub feral_static_pivoting: bool,
+    /// FERAL pivot tolerance (`None`: the solver's default).
+    pub feral_pivtol: Option<f64>,
+    /// Initial barrier parameter of a cold start (`None`: the solver's default, 0.1).
+    pub mu_init: Option<f64>,
+    /// Initial barrier parameter when starting from a previous solution on a refined mesh.
+    pub refine_mu_init: f64,
 }
 
 impl Default for NlpSettings {
@@ -70,6 +78,10 @@ impl Default for NlpSettings {
             feral_ordering: "amf",
             serial_factorization: true,
             feral_scaling: "identity",
+            feral_static_pivoting: false,
+            feral_pivtol: None,
+            mu_init: None,
+            refine_mu_init: 1e-3,
         }
     }
 }
@@ -217,7 +229,9 @@ impl TNLP for Adapter {
                 true
             }
             SparsityRequest::Values { values } => {
-                let (Some(x), Some(lambda)) = (x, lambda) else { return false };
+                let (Some(x), Some(lambda)) = (x, lambda) else {
+                    return false;
+                };
                 self.tr.hessian(x, obj_factor, lambda, values);
                 values.iter().all(|v| v.is_finite())
             }
@@ -264,7 +278,9 @@ impl TNLP for Adapter {
 /// Wires the restoration phase into `app` (a bare application has none). Call after
 /// setting options: the provider copies them.
 fn install_restoration(app: &mut IpoptApplication) {
-    use pounce_rs::pounce_algorithm::application::{Ma57Config, default_backend_factory, feral_config_from_options};
+    use pounce_rs::pounce_algorithm::application::{
+        Ma57Config, default_backend_factory, feral_config_from_options,
+    };
     use pounce_rs::pounce_restoration::resto_alg_builder::RestoAlgorithmBuilder;
     use pounce_rs::pounce_restoration::resto_inner_solver::{
         InnerBackendFactoryFactory, make_default_restoration_factory_provider,
@@ -290,42 +306,54 @@ pub struct OptionError {
     pub reason: String,
 }
 
-fn application(settings: &NlpSettings, warm: bool, budget: Duration) -> Result<IpoptApplication, OptionError> {
+fn application(
+    settings: &NlpSettings,
+    warm: bool,
+    budget: Duration,
+) -> Result<IpoptApplication, OptionError> {
     let mut app = IpoptApplication::new();
     let _ = app.initialize();
     let o = app.options_mut();
     let num = |o: &mut OptionsList, name: &'static str, v: f64| {
-        o.set_numeric_value(name, v, true, false).map(|_| ()).map_err(|e| OptionError {
-            name,
-            reason: format!("{e:?}"),
-        })
+        o.set_numeric_value(name, v, true, false)
+            .map(|_| ())
+            .map_err(|e| OptionError {
+                name,
+                reason: format!("{e:?}"),
+            })
     };
     num(o, "tol", settings.tol)?;
     num(o, "acceptable_tol", settings.acceptable_tol)?;
     num(o, "max_wall_time", budget.as_secs_f64().max(1e-3))?;
     let int = |o: &mut OptionsList, name: &'static str, v: i32| {
-        o.set_integer_value(name, v, true, false).map(|_| ()).map_err(|e| OptionError {
-            name,
-            reason: format!("{e:?}"),
-        })
+        o.set_integer_value(name, v, true, false)
+            .map(|_| ())
+            .map_err(|e| OptionError {
+                name,
+                reason: format!("{e:?}"),
+            })
     };
     int(o, "max_iter", settings.max_iter)?;
     int(o, "acceptable_iter", settings.acceptable_iter)?;
     int(o, "print_level", settings.print_level)?;
     let text = |o: &mut OptionsList, name: &'static str, v: &str| {
-        o.set_string_value(name, v, true, false).map(|_| ()).map_err(|e| OptionError {
-            name,
-            reason: format!("{e:?}"),
-        })
+        o.set_string_value(name, v, true, false)
+            .map(|_| ())
+            .map_err(|e| OptionError {
+                name,
+                reason: format!("{e:?}"),
+            })
     };
     text(o, "hessian_approximation", "exact")?;
     text(o, "mu_strategy", settings.mu_strategy)?;
     text(o, "linear_solver", "feral")?;
     let flag = |o: &mut OptionsList, name: &'static str, v: bool| {
-        o.set_bool_value(name, v, true, false).map(|_| ()).map_err(|e| OptionError {
-            name,
-            reason: format!("{e:?}"),
-        })
+        o.set_bool_value(name, v, true, false)
+            .map(|_| ())
+            .map_err(|e| OptionError {
+                name,
+                reason: format!("{e:?}"),
+            })
     };
     flag(o, "mu_strategy_fallback", false)?;
     flag(o, "solve_quality_audit", false)?;
@@ -334,11 +362,18 @@ fn application(settings: &NlpSettings, warm: bool, budget: Duration) -> Result<I
     flag(o, "feral_refine", settings.feral_refine)?;
     text(o, "feral_ordering", settings.feral_ordering)?;
     text(o, "feral_scaling", settings.feral_scaling)?;
+    flag(o, "feral_static_pivoting", settings.feral_static_pivoting)?;
+    if let Some(p) = settings.feral_pivtol {
+        num(o, "feral_pivtol", p)?;
+    }
     if settings.print_level > 0 {
         flag(o, "print_timing_statistics", true)?;
     }
     if settings.serial_factorization {
         num(o, "feral_min_par_flops", 1e30)?;
+    }
+    if let Some(mu) = settings.mu_init {
+        num(o, "mu_init", mu)?;
     }
     if warm {
         flag(o, "warm_start_init_point", true)?;
@@ -392,9 +427,8 @@ pub fn solve(
         Err(rc) => rc.borrow().clone(),
     };
     let status = match return_status {
-        ApplicationReturnStatus::SolveSucceeded | ApplicationReturnStatus::SolvedToAcceptableLevel => {
-            NlpStatus::Converged
-        }
+        ApplicationReturnStatus::SolveSucceeded
+        | ApplicationReturnStatus::SolvedToAcceptableLevel => NlpStatus::Converged,
         ApplicationReturnStatus::MaximumIterationsExceeded => NlpStatus::MaxIterations,
         ApplicationReturnStatus::MaximumWallTimeExceeded
         | ApplicationReturnStatus::MaximumCpuTimeExceeded

@@ -38,6 +38,12 @@ pub struct TranscriptionSettings {
     pub max_duration_factor: f64,
     /// Length scale of positions in the NLP.
     pub length_scale_m: f64,
+    /// Share of each bounded range kept free at the nodes (gamma, Nz, mu, controls), so
+    /// that the path between nodes and the tracker's corrections stay inside the vehicle's
+    /// true limits.
+    pub bound_margin: f64,
+    /// Height kept above the minimum altitude at the nodes, for the same reason.
+    pub altitude_margin_m: f64,
 }
 
 impl Default for TranscriptionSettings {
@@ -46,6 +52,8 @@ impl Default for TranscriptionSettings {
             min_phase_s: 1.0,
             max_duration_factor: 4.0,
             length_scale_m: 10_000.0,
+            bound_margin: 0.02,
+            altitude_margin_m: 20.0,
         }
     }
 }
@@ -316,7 +324,16 @@ impl Transcription {
         let (nx, dim) = (self.nx, self.dim);
         let n_nodes = self.layout.state_nodes();
         let phases = self.layout.phases();
-        let l = pr.limits;
+        let mut l = pr.limits;
+        let keep = 1.0 - settings.bound_margin;
+        l.turn_rate_max *= keep;
+        l.gamma_max *= keep;
+        l.mu_max *= keep;
+        l.nz_rate_max *= keep;
+        l.mu_rate_max *= keep;
+        let nz_span = (l.nz_max - l.nz_min) * settings.bound_margin / 2.0;
+        (l.nz_min, l.nz_max) = (l.nz_min + nz_span, l.nz_max - nz_span);
+        l.z_min += settings.altitude_margin_m;
         let mut lo = vec![-INF; self.n_vars()];
         let mut hi = vec![INF; self.n_vars()];
         // Path bounds on states and controls.
