@@ -5,6 +5,9 @@
 //! planner service builds it from its world model. Building it allocates; evaluating it
 //! ([`Problem::exposure`], …) does not.
 
+// Index loops here mirror the product rule over the four variables (x, y, z, t).
+#![allow(clippy::needless_range_loop)]
+
 use wingman_interfaces::{MAX_TARGETS, Model, Objective};
 
 use crate::dynamics::{self, SpatialLimits, VehicleLimits};
@@ -45,8 +48,10 @@ pub struct CostWeights {
     pub stiffness: f64,
 }
 
-/// The threat world in the model's dimension.
+/// The threat world in the model's dimension. (The variants hold fixed-capacity layouts of
+/// different sizes; a problem holds one, so boxing would only add an indirection.)
 #[derive(Debug, Clone)]
+#[allow(clippy::large_enum_variant)]
 pub enum Threats {
     /// 2-D: positions `[x, y]`.
     Planar {
@@ -290,9 +295,8 @@ impl Problem {
             return bad("targets must be finite".into());
         }
         let w = &self.weights;
-        if !((0.0..=1.0).contains(&w.alpha) && (0.0..=1.0).contains(&w.beta))
-            || !(w.stiffness > 0.0)
-        {
+        let weights_ok = (0.0..=1.0).contains(&w.alpha) && (0.0..=1.0).contains(&w.beta) && w.stiffness > 0.0;
+        if !weights_ok {
             return bad("weights: alpha and beta must be in [0, 1], stiffness positive".into());
         }
         match self.objective {

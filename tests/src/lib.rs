@@ -1,6 +1,9 @@
 //! Fixtures of the multi-process tests: locate (building once if needed) the real binaries
 //! of the workspace, in the same profile as the running test.
 
+pub mod judge;
+pub mod random_scenario;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
@@ -21,6 +24,14 @@ fn profile_name(dir: &Path) -> String {
         Some(other) => other.to_string(),
         None => "dev".to_string(),
     }
+}
+
+/// The workspace's `target/` folder.
+pub fn target_dir() -> PathBuf {
+    profile_dir()
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("target"))
 }
 
 /// Builds the workspace binaries once per test process, in the test's profile.

@@ -30,7 +30,9 @@ pub struct ExportSettings {
     /// Gains of the tracking law that flies the plan.
     pub gains: TrackingGains,
     /// Fly the plan with the tracking law (else export the reference samples with the
-    /// matched controls).
+    /// matched controls). The 3-D model needs it (unstable in a climb); the 2-D model is
+    /// neutrally stable, so its matched controls replay exactly without feedback, whose
+    /// cross-track corrections would only add heading offsets.
     pub closed_loop: bool,
 }
 
@@ -106,21 +108,27 @@ pub fn export(tr: &Transcription, x: &[f64], settings: &ExportSettings, out: &mu
     out.phase_ends = ends;
     // Controls matching the driven states' increments.
     match tr.nu {
-        1 => match_integral(
-            &out.times.clone(),
-            &out.states.iter().map(|s| s[2]).collect::<Vec<_>>(),
-            &mut out.controls,
-            0,
-        ),
+        1 => {
+            let psi: Vec<f64> = out.states.iter().map(|s| s[2]).collect();
+            let times = out.times.clone();
+            match_integral(
+                &times,
+                &psi,
+                &mut out.controls,
+                0,
+                tr.problem.limits.turn_rate_max,
+            );
+        }
         _ => {
             let times = out.times.clone();
             let nz: Vec<f64> = out.states.iter().map(|s| s[5]).collect();
             let mu: Vec<f64> = out.states.iter().map(|s| s[6]).collect();
-            match_integral(&times, &nz, &mut out.controls, 0);
-            match_integral(&times, &mu, &mut out.controls, 1);
+            let l = &tr.problem.limits;
+            match_integral(&times, &nz, &mut out.controls, 0, l.nz_rate_max);
+            match_integral(&times, &mu, &mut out.controls, 1, l.mu_rate_max);
         }
     }
-    if settings.closed_loop {
+    if settings.closed_loop && tr.nu == 2 {
         fly(tr, settings, out);
     }
 }
@@ -188,19 +196,20 @@ const MATCH_GAIN: f64 = 0.5;
 /// `Y` follows the samples `y`: each sample takes the centred slope of `y` and corrects
 /// `MATCH_GAIN` of the gap between `Y` and `y` at the next sample. The integral then
 /// tracks `y` to a fraction of one step's local error, and any alternating mode decays by
-/// `MATCH_GAIN` per step.
-fn match_integral(t: &[f64], y: &[f64], controls: &mut [[f64; 2]], slot: usize) {
+/// `MATCH_GAIN` per step. Controls are clamped to `±bound` (the vehicle's limit); a gap a
+/// clamp leaves is made up by the samples after it.
+fn match_integral(t: &[f64], y: &[f64], controls: &mut [[f64; 2]], slot: usize, bound: f64) {
     let n = t.len();
     if n < 2 {
         return;
     }
     let slope = |k: usize| quadratic_slope(t, y, k);
     let mut integral = y[0];
-    controls[0][slot] = slope(0);
+    controls[0][slot] = slope(0).clamp(-bound, bound);
     for k in 0..n - 1 {
         let dt = t[k + 1] - t[k];
         let exact = 2.0 * (y[k + 1] - integral) / dt - controls[k][slot];
-        let u = (1.0 - MATCH_GAIN) * slope(k + 1) + MATCH_GAIN * exact;
+        let u = ((1.0 - MATCH_GAIN) * slope(k + 1) + MATCH_GAIN * exact).clamp(-bound, bound);
         controls[k + 1][slot] = u;
         integral += (controls[k][slot] + u) / 2.0 * dt;
     }
@@ -236,7 +245,7 @@ mod tests {
             .map(|&s| (s / 30.0).sin() + 0.001 * s * s)
             .collect();
         let mut u = vec![[0.0; 2]; t.len()];
-        match_integral(&t, &y, &mut u, 1);
+        match_integral(&t, &y, &mut u, 1, f64::INFINITY);
         let mut integral = y[0];
         for k in 0..t.len() - 1 {
             integral += (u[k][1] + u[k + 1][1]) / 2.0 * (t[k + 1] - t[k]);
@@ -272,7 +281,7 @@ mod tests {
             })
             .collect();
         let mut u = vec![[0.0; 2]; t.len()];
-        match_integral(&t, &y, &mut u, 0);
+        match_integral(&t, &y, &mut u, 0, f64::INFINITY);
         let mut integral = y[0];
         for k in 0..t.len() - 1 {
             integral += (u[k][0] + u[k + 1][0]) / 2.0 * (t[k + 1] - t[k]);

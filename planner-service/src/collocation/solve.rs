@@ -446,14 +446,15 @@ pub fn solve(
         (None, _) => a.start.x.clone(),
     };
     let mut violation = a.tr.violation(&x, &mut g);
-    if status != NlpStatus::Converged && a.has_best {
-        if let Some(last) = &last {
-            // The last iterate may be feasible and better than the best seen in a callback.
-            let v_last = a.tr.violation(last, &mut g);
-            if v_last <= settings.feasibility_tol && a.tr.objective(last) < a.tr.objective(&x) {
-                x = last.clone();
-                violation = v_last;
-            }
+    if status != NlpStatus::Converged
+        && a.has_best
+        && let Some(last) = &last
+    {
+        // The last iterate may be feasible and better than the best seen in a callback.
+        let v_last = a.tr.violation(last, &mut g);
+        if v_last <= settings.feasibility_tol && a.tr.objective(last) < a.tr.objective(&x) {
+            x = last.clone();
+            violation = v_last;
         }
     }
     let objective = a.tr.objective(&x) / a.tr.obj_scale;

@@ -19,6 +19,9 @@
 //! node, and a fixed final state fixes the final node (heading modulo 2π: the multiple of
 //! 2π nearest the initial guess). Threats are only in the cost, never constraints.
 
+// Index loops here mirror the equations (rows, nodes, state components) one to one.
+#![allow(clippy::needless_range_loop)]
+
 use wingman_interfaces::{Model, Objective};
 
 use super::mesh::{Layout, Mesh};

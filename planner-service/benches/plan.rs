@@ -1,0 +1,115 @@
+//! Planner benchmark (issue 5): for every canonical scenario, the take-off plan with 20
+//! swarm seeds — median and p95 of the plan time, the share of swarm, NLP and the rest,
+//! the cost spread across seeds, peak heap — and how far past a too-short deadline the
+//! planner returns. Prints a Markdown table (run with `cargo bench -p wingman-planner
+//! --bench plan`; `-- --runs N`, `-- --only NAME` to narrow it).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Duration;
+
+use wingman_planner::clock::{Clock, Deadline, MonotonicClock};
+use wingman_planner::hybrid::{Planner, PlannerSettings};
+use wingman_planner::problem::Problem;
+use wingman_planner::scenario::{BUNDLED, bundled};
+
+struct Peak;
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Peak {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let now = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
+        PEAK.fetch_max(now, Ordering::Relaxed);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Peak = Peak;
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    let k = ((sorted.len() as f64 - 1.0) * p).round() as usize;
+    sorted[k.min(sorted.len() - 1)]
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let runs: u64 = args.iter().position(|a| a == "--runs").and_then(|i| args.get(i + 1)).and_then(|v| v.parse().ok()).unwrap_or(20);
+    let only = args.iter().position(|a| a == "--only").and_then(|i| args.get(i + 1)).cloned();
+    let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
+    let settings = PlannerSettings::default();
+    println!("| scenario | median ms | p95 ms | swarm % | NLP % | rest % | cost min | cost max | spread % | peak heap MiB | quality |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    for (name, _) in BUNDLED {
+        if only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
+            continue;
+        }
+        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+        let mut times = Vec::new();
+        let (mut swarm, mut nlp, mut total) = (0.0, 0.0, 0.0);
+        let mut costs = Vec::new();
+        let mut qualities = std::collections::BTreeMap::new();
+        let base = LIVE.load(Ordering::Relaxed);
+        PEAK.store(base, Ordering::Relaxed);
+        for seed in 1..=runs {
+            let s = PlannerSettings {
+                swarm: settings.swarm.clone().with_seed(seed),
+                ..settings.clone()
+            };
+            let mut planner = Planner::new(&s);
+            let out = planner.plan(&problem, &s, Deadline::after(clock, Duration::from_secs(30))).unwrap();
+            let t = out.times.total.as_secs_f64() * 1e3;
+            times.push(t);
+            swarm += out.times.swarm.as_secs_f64() * 1e3;
+            nlp += out.times.nlp.as_secs_f64() * 1e3;
+            total += t;
+            costs.push(out.cost);
+            *qualities.entry(format!("{:?}", out.quality)).or_insert(0) += 1;
+        }
+        let peak = (PEAK.load(Ordering::Relaxed) - base) as f64 / (1024.0 * 1024.0);
+        times.sort_by(f64::total_cmp);
+        costs.sort_by(f64::total_cmp);
+        let (lo, hi) = (costs[0], costs[costs.len() - 1]);
+        println!(
+            "| {name} | {:.1} | {:.1} | {:.0} | {:.0} | {:.0} | {lo:.6} | {hi:.6} | {:.3} | {peak:.1} | {} |",
+            percentile(&times, 0.5),
+            percentile(&times, 0.95),
+            100.0 * swarm / total,
+            100.0 * nlp / total,
+            100.0 * (total - swarm - nlp) / total,
+            100.0 * (hi - lo) / lo.abs().max(1e-12),
+            qualities.iter().map(|(q, n)| format!("{q} {n}")).collect::<Vec<_>>().join(", "),
+        );
+    }
+    // Deadline overshoot: a budget far too short for the NLP.
+    println!("\n| scenario | budget ms | returned after ms (median / max of {runs}) | quality |");
+    println!("|---|---:|---:|---|");
+    for name in ["2d-min-time-avoidable", "3d-min-time-rendezvous-avoidable"] {
+        if only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
+            continue;
+        }
+        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+        for budget_ms in [5u64, 20, 50] {
+            let mut over = Vec::new();
+            let mut quality = String::new();
+            for seed in 1..=runs {
+                let s = PlannerSettings {
+                    swarm: settings.swarm.clone().with_seed(seed),
+                    ..settings.clone()
+                };
+                let mut planner = Planner::new(&s);
+                let began = clock.now();
+                let out = planner.plan(&problem, &s, Deadline::after(clock, Duration::from_millis(budget_ms))).unwrap();
+                over.push((clock.now() - began).as_secs_f64() * 1e3);
+                quality = format!("{:?}", out.quality);
+            }
+            over.sort_by(f64::total_cmp);
+            println!("| {name} | {budget_ms} | {:.1} / {:.1} | {quality} (last) |", percentile(&over, 0.5), over[over.len() - 1]);
+        }
+    }
+}

@@ -1,0 +1,135 @@
+//! The hybrid planner's contract: same input and seed give the same plan bit for bit; a
+//! deadline too short for the NLP still returns a finite, flyable plan flagged
+//! `SwarmOnly` or `Feasible`; bad input is an error, not a panic.
+
+use std::time::Duration;
+use wingman_interfaces::Quality;
+use wingman_planner::clock::{Deadline, MonotonicClock};
+use wingman_planner::hybrid::{Planner, PlannerSettings};
+use wingman_planner::problem::Problem;
+use wingman_planner::scenario::bundled;
+
+fn clock() -> &'static MonotonicClock {
+    Box::leak(Box::new(MonotonicClock::new()))
+}
+
+fn bits(tr: &wingman_planner::trajectory::Trajectory) -> Vec<u64> {
+    let mut out: Vec<u64> = tr.times.iter().map(|v| v.to_bits()).collect();
+    out.extend(tr.states.iter().flatten().map(|v| v.to_bits()));
+    out.extend(tr.controls.iter().flatten().map(|v| v.to_bits()));
+    out.extend(tr.phase_ends.iter().map(|v| v.to_bits()));
+    out
+}
+
+#[test]
+fn same_input_and_seed_give_the_same_plan_bit_for_bit() {
+    for name in [
+        "2d-min-time-rendezvous-avoidable",
+        "3d-min-time-moving-threat",
+    ] {
+        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+        let settings = PlannerSettings::default();
+        let run = || {
+            let mut planner = Planner::new(&settings);
+            planner
+                .plan(
+                    &problem,
+                    &settings,
+                    Deadline::after(clock(), Duration::from_secs(120)),
+                )
+                .unwrap()
+        };
+        let (a, b) = (run(), run());
+        assert_eq!(a.quality, Quality::Optimal, "{name}");
+        assert_eq!(
+            bits(&a.trajectory),
+            bits(&b.trajectory),
+            "{name}: plans differ"
+        );
+        // A planner reused for a second plan (workspace reuse) gives the same plan too.
+        let mut planner = Planner::new(&settings);
+        let _ = planner
+            .plan(
+                &problem,
+                &settings,
+                Deadline::after(clock(), Duration::from_secs(120)),
+            )
+            .unwrap();
+        let c = planner
+            .plan(
+                &problem,
+                &settings,
+                Deadline::after(clock(), Duration::from_secs(120)),
+            )
+            .unwrap();
+        assert_eq!(
+            bits(&a.trajectory),
+            bits(&c.trajectory),
+            "{name}: a reused planner differs"
+        );
+    }
+}
+
+#[test]
+fn a_deadline_too_short_for_the_nlp_still_gives_a_flyable_plan() {
+    for name in ["2d-min-time-avoidable", "3d-min-time-rendezvous-avoidable"] {
+        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+        let settings = PlannerSettings::default();
+        let mut planner = Planner::new(&settings);
+        let out = planner
+            .plan(
+                &problem,
+                &settings,
+                Deadline::after(clock(), Duration::from_millis(5)),
+            )
+            .unwrap();
+        assert!(
+            matches!(out.quality, Quality::SwarmOnly | Quality::Feasible),
+            "{name}: {:?}",
+            out.quality
+        );
+        assert!(
+            out.trajectory.is_valid(),
+            "{name}: the plan must be finite and ordered"
+        );
+        assert!(out.cost.is_finite(), "{name}");
+        // Flyable: it starts at the start state and has one end time per phase.
+        assert_eq!(out.trajectory.phase_ends.len(), problem.phases());
+        for c in 0..problem.nx() {
+            assert!(
+                (out.trajectory.states[0][c] - problem.x0[c]).abs() < 1e-6,
+                "{name}: state {c}"
+            );
+        }
+    }
+}
+
+#[test]
+fn bad_input_is_an_error() {
+    let mut problem =
+        Problem::from_scenario(&bundled("2d-min-time-avoidable").unwrap().unwrap()).unwrap();
+    problem.x0[0] = f64::NAN;
+    let settings = PlannerSettings::default();
+    let mut planner = Planner::new(&settings);
+    assert!(
+        planner
+            .plan(
+                &problem,
+                &settings,
+                Deadline::after(clock(), Duration::from_secs(1))
+            )
+            .is_err()
+    );
+    let mut problem =
+        Problem::from_scenario(&bundled("2d-fixed-time-avoidable").unwrap().unwrap()).unwrap();
+    problem.final_time = Some(problem.t0 - 1.0);
+    assert!(
+        planner
+            .plan(
+                &problem,
+                &settings,
+                Deadline::after(clock(), Duration::from_secs(1))
+            )
+            .is_err()
+    );
+}
