@@ -13,12 +13,14 @@ use std::time::Duration;
 
 use wingman_interfaces::Quality;
 
+use crate::basins;
 use crate::clock::Deadline;
 use crate::collocation::{
     ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, RefineSettings, Transcription,
     TranscriptionSettings, export, interval_errors, refine, solve,
 };
 use crate::problem::Problem;
+use crate::seeding::{self, Seed};
 use crate::swarm::{self, SwarmOutcome, SwarmSettings, SwarmWorkspace};
 use crate::trajectory::Trajectory;
 
@@ -56,6 +58,11 @@ pub struct PlannerSettings {
     pub export: ExportSettings,
     /// Largest share of the deadline the swarm may use.
     pub swarm_share: f64,
+    /// NLP starts from distinct basins: the swarm's best and the best seeds that pass some
+    /// threat on another side (see `basins`).
+    pub starts: usize,
+    /// Threads solving the starts' NLPs side by side.
+    pub threads: usize,
 }
 
 impl Default for PlannerSettings {
@@ -72,6 +79,8 @@ impl Default for PlannerSettings {
             refine_rounds: 3,
             export: ExportSettings::default(),
             swarm_share: 0.3,
+            starts: 4,
+            threads: 2,
         }
     }
 }
@@ -87,6 +96,8 @@ pub enum PlanError {
     Nlp(#[from] crate::collocation::solve::OptionError),
     #[error("the planner produced a non-finite trajectory")]
     NonFinite,
+    #[error("seeds: {0}")]
+    Seeds(String),
 }
 
 /// Time spent in each stage.
@@ -130,12 +141,69 @@ pub struct PlanOutcome {
 /// The planner with its reusable workspace.
 pub struct Planner {
     swarm: SwarmWorkspace,
+    seeds: Vec<Seed>,
+}
+
+/// One NLP solve's accepted result.
+struct Solved {
+    tr: Transcription,
+    x: Vec<f64>,
+    quality: Quality,
+    objective: f64,
+    iterations: usize,
+    status: NlpStatus,
+}
+
+/// Solves `problem` on `mesh` from `guess`; `None` if the result is not feasible.
+fn solve_on_mesh(
+    problem: &Problem,
+    mesh: &Mesh,
+    guess: &Trajectory,
+    settings: &PlannerSettings,
+    refined: bool,
+    deadline: Deadline<'static>,
+) -> Result<(Option<Solved>, usize, NlpStatus), PlanError> {
+    let mut tr = Transcription::new(problem, mesh, guess, &settings.transcription);
+    let mut x = vec![0.0; tr.n_vars()];
+    tr.initial_point(guess, &mut x);
+    let j0 = tr.objective(&x);
+    tr.obj_scale = 1.0 / j0.abs().max(1e-3);
+    let mut nlp = settings.nlp.clone();
+    if refined {
+        // A refined mesh starts from the previous solution: a small barrier keeps it.
+        nlp.mu_init = Some(settings.nlp.refine_mu_init);
+    }
+    let (tr, out) = solve(
+        tr,
+        PrimalDual {
+            x,
+            ..PrimalDual::default()
+        },
+        false,
+        &nlp,
+        deadline,
+    )?;
+    let quality = match (out.status, out.feasible) {
+        (NlpStatus::Converged, true) => Some(Quality::Optimal),
+        (_, true) => Some(Quality::Feasible),
+        _ => None,
+    };
+    let solved = quality.map(|quality| Solved {
+        tr,
+        x: out.x,
+        quality,
+        objective: out.objective,
+        iterations: out.iterations,
+        status: out.status,
+    });
+    Ok((solved, out.iterations, out.status))
 }
 
 impl Planner {
     pub fn new(settings: &PlannerSettings) -> Planner {
         Planner {
             swarm: SwarmWorkspace::new(&settings.swarm),
+            seeds: Vec::new(),
         }
     }
 
@@ -173,58 +241,81 @@ impl Planner {
             intervals: Vec::new(),
             objective: f64::NAN,
         };
-        // The accepted NLP result so far: transcription, solution, quality.
-        let mut accepted: Option<(Transcription, Vec<f64>, Quality)> = None;
-        let durations = phase_durations(problem.t0, &sw.best);
-        let mut mesh = Mesh::uniform(
-            settings.mesh.points,
-            &durations,
-            settings.mesh.interval_s,
-            settings.mesh.min_intervals,
+        // Starts from distinct basins, solved side by side on the first mesh.
+        seeding::seeds(problem, &settings.swarm.seeds, &mut self.seeds)
+            .map_err(|e| PlanError::Seeds(e.to_string()))?;
+        let starts = basins::candidates(
+            problem,
+            &sw.best,
+            &self.seeds,
+            settings.starts.max(1),
+            |tr| trajectory_cost(problem, tr),
         );
-        let mut guess = sw.best.clone();
-        for round in 0..=settings.refine_rounds {
-            if deadline.expired() {
+        let meshes: Vec<Mesh> = starts
+            .iter()
+            .map(|g| {
+                Mesh::uniform(
+                    settings.mesh.points,
+                    &phase_durations(problem.t0, g),
+                    settings.mesh.interval_s,
+                    settings.mesh.min_intervals,
+                )
+            })
+            .collect();
+        let threads = settings.threads.clamp(1, starts.len());
+        let results: Vec<Result<(Option<Solved>, usize, NlpStatus), PlanError>> =
+            std::thread::scope(|scope| {
+                let workers: Vec<_> = (0..threads)
+                    .map(|w| {
+                        let (starts, meshes) = (&starts, &meshes);
+                        scope.spawn(move || {
+                            (w..starts.len())
+                                .step_by(threads)
+                                .map(|i| {
+                                    (
+                                        i,
+                                        solve_on_mesh(
+                                            problem, &meshes[i], &starts[i], settings, false,
+                                            deadline,
+                                        ),
+                                    )
+                                })
+                                .collect::<Vec<_>>()
+                        })
+                    })
+                    .collect();
+                let mut all: Vec<(usize, Result<(Option<Solved>, usize, NlpStatus), PlanError>)> =
+                    workers
+                        .into_iter()
+                        .flat_map(|h| h.join().unwrap_or_default())
+                        .collect();
+                all.sort_by_key(|(i, _)| *i);
+                all.into_iter().map(|(_, r)| r).collect()
+            });
+        let mut accepted: Option<Solved> = None;
+        let mut mesh = meshes[0].clone();
+        for (i, r) in results.into_iter().enumerate() {
+            let (solved, iterations, status) = r?;
+            report.iterations.push(iterations);
+            report.status = Some(status);
+            if let Some(s) = solved {
+                // Lowest objective wins; ties go to the earlier start (deterministic).
+                if accepted.as_ref().is_none_or(|a| s.objective < a.objective) {
+                    mesh = meshes[i].clone();
+                    accepted = Some(s);
+                }
+            }
+        }
+        let mut guess = Trajectory::default();
+        for _ in 0..settings.refine_rounds {
+            let Some(current) = accepted.as_ref() else {
                 break;
-            }
-            let mut tr = Transcription::new(problem, &mesh, &guess, &settings.transcription);
-            let mut x = vec![0.0; tr.n_vars()];
-            tr.initial_point(&guess, &mut x);
-            let j0 = tr.objective(&x);
-            tr.obj_scale = 1.0 / j0.abs().max(1e-3);
-            let mut nlp = settings.nlp.clone();
-            if round > 0 {
-                // A refined mesh starts from the previous solution: a small barrier keeps it.
-                nlp.mu_init = Some(settings.nlp.refine_mu_init);
-            }
-            let (tr, out) = solve(
-                tr,
-                PrimalDual {
-                    x,
-                    ..PrimalDual::default()
-                },
-                false,
-                &nlp,
-                deadline,
-            )?;
-            report.iterations.push(out.iterations);
-            report.status = Some(out.status);
-            let quality = match (out.status, out.feasible) {
-                (NlpStatus::Converged, true) => Some(Quality::Optimal),
-                (_, true) => Some(Quality::Feasible),
-                _ => None,
             };
-            let Some(quality) = quality else { break };
-            report.objective = out.objective;
-            report.intervals = mesh.phases.iter().map(Vec::len).collect();
-            let converged = quality == Quality::Optimal;
-            accepted = Some((tr, out.x, quality));
-            if !converged || round == settings.refine_rounds {
+            if current.quality != Quality::Optimal || deadline.expired() {
                 break;
             }
-            let (tr, x, _) = accepted.as_ref().expect("just accepted");
             let mut errors = Vec::new();
-            interval_errors(tr, x, &mut errors);
+            interval_errors(&current.tr, &current.x, &mut errors);
             let Some(next) = refine(&mesh, &errors, &settings.refine) else {
                 break;
             };
@@ -233,17 +324,33 @@ impl Planner {
                 max_step_s: settings.export.max_step_s / 2.0,
                 ..settings.export
             };
-            export(tr, x, &reference, &mut guess);
-            mesh = next;
+            export(&current.tr, &current.x, &reference, &mut guess);
+            let (solved, iterations, status) =
+                solve_on_mesh(problem, &next, &guess, settings, true, deadline)?;
+            report.iterations.push(iterations);
+            report.status = Some(status);
+            match solved {
+                Some(s) => {
+                    accepted = Some(s);
+                    mesh = next;
+                }
+                None => break,
+            }
+        }
+        if let Some(a) = &accepted {
+            report.objective = a.objective;
+            report.status = Some(a.status);
+            report.intervals = mesh.phases.iter().map(Vec::len).collect();
+            let _ = a.iterations;
         }
         times.nlp = clock.now().saturating_sub(nlp_started);
 
         let export_started = clock.now();
         let (quality, trajectory) = match &accepted {
-            Some((tr, x, quality)) => {
+            Some(a) => {
                 let mut flown = Trajectory::default();
-                export(tr, x, &settings.export, &mut flown);
-                (*quality, flown)
+                export(&a.tr, &a.x, &settings.export, &mut flown);
+                (a.quality, flown)
             }
             None => (Quality::SwarmOnly, sw.best.clone()),
         };

@@ -1,0 +1,185 @@
+//! Starts for the NLP from distinct basins. A gradient method only finds the optimum of
+//! the basin it starts in, and with threats the basins are (mostly) the homotopy classes
+//! of the path: on which side it passes each threat. The swarm's best is one start; the
+//! best seeds that pass some threat on the *other* side are the others (the reference
+//! optimum itself was found by a multistart over such left/right arc combinations).
+
+use wingman_interfaces::Model;
+
+use crate::dynamics::{ReducedPath, Spatial, lift_reduced_path, wrap_angle};
+use crate::problem::{Problem, Threats};
+use crate::seeding::Seed;
+use crate::trajectory::Trajectory;
+
+/// Side on which a path passes each threat it comes near: +1 left, -1 right, 0 far.
+pub type Signature = Vec<i8>;
+
+/// Threat centres (horizontal) and a "near" radius (twice the largest horizontal axis).
+fn threat_discs(problem: &Problem) -> Vec<([f64; 2], f64)> {
+    match &problem.threats {
+        Threats::Planar { layout, .. } => layout
+            .threats()
+            .iter()
+            .map(|t| (*t.center(), 2.0 * t.axes()[0].max(t.axes()[1])))
+            .collect(),
+        Threats::Spatial { layout, .. } => layout
+            .threats()
+            .iter()
+            .map(|t| {
+                (
+                    [t.center()[0], t.center()[1]],
+                    2.0 * t.axes()[0].max(t.axes()[1]),
+                )
+            })
+            .collect(),
+    }
+}
+
+/// The side on which the horizontal path `points` passes each threat.
+pub fn signature(problem: &Problem, points: &[[f64; 2]]) -> Signature {
+    threat_discs(problem)
+        .into_iter()
+        .map(|(c, near)| {
+            let mut best = (f64::INFINITY, 0usize);
+            for (k, p) in points.iter().enumerate() {
+                let d = (p[0] - c[0]).hypot(p[1] - c[1]);
+                if d < best.0 {
+                    best = (d, k);
+                }
+            }
+            if best.0 > near || points.len() < 2 {
+                return 0;
+            }
+            let k = best.1.min(points.len() - 2);
+            let dir = [
+                points[k + 1][0] - points[k][0],
+                points[k + 1][1] - points[k][1],
+            ];
+            let to_c = [c[0] - points[k][0], c[1] - points[k][1]];
+            // The threat is on the right of the path when the path passes on its left.
+            let cross = dir[0] * to_c[1] - dir[1] * to_c[0];
+            if cross < 0.0 { 1 } else { -1 }
+        })
+        .collect()
+}
+
+/// Whether two signatures may be the same class: they agree on every threat both pass
+/// near (a far threat, 0, may be passed either way once the NLP moves the path).
+pub fn same_class(a: &Signature, b: &Signature) -> bool {
+    a.iter().zip(b).all(|(x, y)| *x == 0 || *y == 0 || x == y)
+}
+
+/// A seed flown at the vehicle's speed as a full-model trajectory (3-D: lifted with eqs.
+/// 5.13–5.15), with its targets' pass times as phase ends.
+pub fn seed_trajectory(problem: &Problem, seed: &Seed) -> Option<Trajectory> {
+    let pts = seed.points();
+    let n = pts.len();
+    if n < 3 {
+        return None;
+    }
+    let v = problem.limits.speed;
+    let mut times = Vec::with_capacity(n);
+    let mut t = problem.t0;
+    times.push(t);
+    for k in 1..n {
+        let d = ((pts[k][0] - pts[k - 1][0]).powi(2)
+            + (pts[k][1] - pts[k - 1][1]).powi(2)
+            + (pts[k][2] - pts[k - 1][2]).powi(2))
+        .sqrt();
+        t += (d / v).max(1e-3);
+        times.push(t);
+    }
+    let h0 = problem.x0[problem.heading_index()];
+    let mut chi = Vec::with_capacity(n);
+    let mut gamma = Vec::with_capacity(n);
+    for k in 0..n {
+        let (a, b) = if k + 1 < n {
+            (pts[k], pts[k + 1])
+        } else {
+            (pts[k - 1], pts[k])
+        };
+        let heading = (b[1] - a[1]).atan2(b[0] - a[0]);
+        let prev = chi.last().copied().unwrap_or(h0);
+        chi.push(prev + wrap_angle(heading - prev));
+        gamma.push((b[2] - a[2]).atan2((b[0] - a[0]).hypot(b[1] - a[1])));
+    }
+    let mut tr = Trajectory::default();
+    match problem.model {
+        Model::TwoD => {
+            for k in 0..n {
+                let u = if k + 1 < n {
+                    (chi[k + 1] - chi[k]) / (times[k + 1] - times[k])
+                } else {
+                    0.0
+                };
+                let u = u.clamp(-problem.limits.turn_rate_max, problem.limits.turn_rate_max);
+                tr.push(
+                    times[k],
+                    [pts[k][0], pts[k][1], chi[k], 0.0, 0.0, 0.0, 0.0],
+                    [u, 0.0],
+                );
+            }
+        }
+        Model::ThreeD => {
+            let gmax = problem.limits.gamma_max;
+            let gamma: Vec<f64> = gamma.iter().map(|g| g.clamp(-gmax, gmax)).collect();
+            let model = Spatial::new(v).ok()?;
+            let mut states = vec![[0.0; 7]; n];
+            let mut controls = vec![[0.0; 2]; n];
+            let path = ReducedPath {
+                times: &times,
+                positions: pts,
+                gamma: &gamma,
+                chi: &chi,
+            };
+            lift_reduced_path(&model, &path, &mut states, &mut controls).ok()?;
+            let l = &problem.limits;
+            for k in 0..n {
+                let mut s = states[k];
+                s[4] = chi[k];
+                s[5] = s[5].clamp(l.nz_min, l.nz_max);
+                s[6] = s[6].clamp(-l.mu_max, l.mu_max);
+                tr.push(times[k], s, controls[k]);
+            }
+        }
+    }
+    tr.phase_ends = seed.gates().iter().map(|&g| times[g.min(n - 1)]).collect();
+    tr.phase_ends.truncate(problem.phases());
+    (tr.phase_ends.len() == problem.phases() && tr.is_valid()).then_some(tr)
+}
+
+/// Up to `count` starts: `first` (the swarm's best), then the cheapest seeds whose
+/// signature differs from every start taken so far, ranked by `cost`.
+pub fn candidates(
+    problem: &Problem,
+    first: &Trajectory,
+    seeds: &[Seed],
+    count: usize,
+    cost: impl Fn(&Trajectory) -> f64,
+) -> Vec<Trajectory> {
+    let xy =
+        |tr: &Trajectory| -> Vec<[f64; 2]> { tr.states.iter().map(|s| [s[0], s[1]]).collect() };
+    let mut taken = vec![signature(problem, &xy(first))];
+    let mut out = vec![first.clone()];
+    if count <= 1 {
+        return out;
+    }
+    let mut ranked: Vec<(f64, usize, Trajectory)> = seeds
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| seed_trajectory(problem, s).map(|tr| (cost(&tr), i, tr)))
+        .filter(|(c, _, _)| c.is_finite())
+        .collect();
+    ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    for (_, _, tr) in ranked {
+        if out.len() >= count {
+            break;
+        }
+        let sig = signature(problem, &xy(&tr));
+        if taken.iter().all(|t| !same_class(t, &sig)) {
+            taken.push(sig);
+            out.push(tr);
+        }
+    }
+    out
+}
