@@ -38,8 +38,8 @@ pub struct MeshSettings {
 impl Default for MeshSettings {
     fn default() -> Self {
         MeshSettings {
-            points: 8,
-            interval_s: 40.0,
+            points: 6,
+            interval_s: 25.0,
             min_intervals: 2,
         }
     }
