@@ -11,7 +11,8 @@ use crate::problem::{Problem, Threats};
 use crate::seeding::Seed;
 use crate::trajectory::Trajectory;
 
-/// Side on which a path passes each threat it comes near: +1 left, -1 right, 0 far.
+/// Side on which a path passes each threat it comes near: +1 left, -1 right, 0 far or
+/// through it (crossing a threat, e.g. to reach a target inside it, has no side).
 pub type Signature = Vec<i8>;
 
 /// Threat centres (horizontal) and a "near" radius (twice the largest horizontal axis).
@@ -35,11 +36,20 @@ fn threat_discs(problem: &Problem) -> Vec<([f64; 2], f64)> {
     }
 }
 
-/// The side on which the horizontal path `points` passes each threat.
-pub fn signature(problem: &Problem, points: &[[f64; 2]]) -> Signature {
+/// `F` of static threat `i` at `p` (`[x, y, z]`, z ignored in 2-D).
+fn threat_f(problem: &Problem, i: usize, p: &[f64; 3]) -> f64 {
+    match &problem.threats {
+        Threats::Planar { layout, .. } => layout.threats()[i].f(&[p[0], p[1]]),
+        Threats::Spatial { layout, .. } => layout.threats()[i].f(p),
+    }
+}
+
+/// The side on which the path `points` (`[x, y, z]`) passes each threat.
+pub fn signature(problem: &Problem, points: &[[f64; 3]]) -> Signature {
     threat_discs(problem)
         .into_iter()
-        .map(|(c, near)| {
+        .enumerate()
+        .map(|(i, (c, near))| {
             let mut best = (f64::INFINITY, 0usize);
             for (k, p) in points.iter().enumerate() {
                 let d = (p[0] - c[0]).hypot(p[1] - c[1]);
@@ -47,7 +57,7 @@ pub fn signature(problem: &Problem, points: &[[f64; 2]]) -> Signature {
                     best = (d, k);
                 }
             }
-            if best.0 > near || points.len() < 2 {
+            if best.0 > near || points.len() < 2 || threat_f(problem, i, &points[best.1]) < 1.0 {
                 return 0;
             }
             let k = best.1.min(points.len() - 2);
@@ -157,8 +167,13 @@ pub fn candidates(
     count: usize,
     cost: impl Fn(&Trajectory) -> f64,
 ) -> Vec<Trajectory> {
-    let xy =
-        |tr: &Trajectory| -> Vec<[f64; 2]> { tr.states.iter().map(|s| [s[0], s[1]]).collect() };
+    let three_d = problem.dim() == 3;
+    let xy = |tr: &Trajectory| -> Vec<[f64; 3]> {
+        tr.states
+            .iter()
+            .map(|s| [s[0], s[1], if three_d { s[2] } else { 0.0 }])
+            .collect()
+    };
     let mut taken = vec![signature(problem, &xy(first))];
     let mut out = vec![first.clone()];
     if count <= 1 {
