@@ -186,6 +186,7 @@ pub fn candidates(
         .filter(|(c, _, _)| c.is_finite())
         .collect();
     ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let mut rest = Vec::new();
     for (_, _, tr) in ranked {
         if out.len() >= count {
             break;
@@ -194,7 +195,35 @@ pub fn candidates(
         if taken.iter().all(|t| !same_class(t, &sig)) {
             taken.push(sig);
             out.push(tr);
+        } else {
+            rest.push(tr);
+        }
+    }
+    // Fewer classes than slots (e.g. paths that must cross threats, where only the
+    // crossing point differs): fill with the cheapest seeds that are geometrically apart
+    // from every start taken (mean horizontal distance over the path's fraction).
+    for tr in rest {
+        if out.len() >= count {
+            break;
+        }
+        let separation = |a: &Trajectory, b: &Trajectory| -> f64 {
+            let n = 32;
+            (0..n)
+                .map(|k| {
+                    let f = (k as f64 + 0.5) / n as f64;
+                    let pa = &a.states[((a.len() - 1) as f64 * f) as usize];
+                    let pb = &b.states[((b.len() - 1) as f64 * f) as usize];
+                    (pa[0] - pb[0]).hypot(pa[1] - pb[1])
+                })
+                .sum::<f64>()
+                / n as f64
+        };
+        if out.iter().all(|o| separation(o, &tr) > MIN_SEPARATION_M) {
+            out.push(tr);
         }
     }
     out
 }
+
+/// Mean horizontal distance that makes a same-class seed a distinct start.
+const MIN_SEPARATION_M: f64 = 3000.0;

@@ -63,6 +63,12 @@ pub struct PlannerSettings {
     pub starts: usize,
     /// Threads solving the starts' NLPs side by side.
     pub threads: usize,
+    /// The coarser mesh on which all starts are first ranked.
+    pub ranking_mesh: MeshSettings,
+    /// Largest scaled constraint violation of a ranking solve that still ranks.
+    pub ranking_feasibility_tol: f64,
+    /// How many of the best-ranked starts are solved again on the working mesh.
+    pub finalists: usize,
 }
 
 impl Default for PlannerSettings {
@@ -79,8 +85,15 @@ impl Default for PlannerSettings {
             refine_rounds: 3,
             export: ExportSettings::default(),
             swarm_share: 0.3,
-            starts: 4,
+            starts: 6,
             threads: 2,
+            ranking_mesh: MeshSettings {
+                points: 5,
+                interval_s: 35.0,
+                min_intervals: 2,
+            },
+            ranking_feasibility_tol: 1e-4,
+            finalists: 2,
         }
     }
 }
@@ -161,6 +174,7 @@ fn solve_on_mesh(
     guess: &Trajectory,
     settings: &PlannerSettings,
     refined: bool,
+    feasibility_tol: f64,
     deadline: Deadline<'static>,
 ) -> Result<(Option<Solved>, usize, NlpStatus), PlanError> {
     let mut tr = Transcription::new(problem, mesh, guess, &settings.transcription);
@@ -183,7 +197,8 @@ fn solve_on_mesh(
         &nlp,
         deadline,
     )?;
-    let quality = match (out.status, out.feasible) {
+    let feasible = out.violation <= feasibility_tol;
+    let quality = match (out.status, feasible) {
         (NlpStatus::Converged, true) => Some(Quality::Optimal),
         (_, true) => Some(Quality::Feasible),
         _ => None,
@@ -197,6 +212,36 @@ fn solve_on_mesh(
         status: out.status,
     });
     Ok((solved, out.iterations, out.status))
+}
+
+type SolveResult = Result<(Option<Solved>, usize, NlpStatus), PlanError>;
+
+/// Runs `job(i)` for `i in 0..n` on up to `threads` threads; results in index order.
+fn in_parallel(
+    n: usize,
+    threads: usize,
+    job: impl Fn(usize) -> SolveResult + Sync,
+) -> Vec<SolveResult> {
+    let threads = threads.clamp(1, n.max(1));
+    std::thread::scope(|scope| {
+        let job = &job;
+        let workers: Vec<_> = (0..threads)
+            .map(|w| {
+                scope.spawn(move || {
+                    (w..n)
+                        .step_by(threads)
+                        .map(|i| (i, job(i)))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        let mut all: Vec<(usize, SolveResult)> = workers
+            .into_iter()
+            .flat_map(|h| h.join().unwrap_or_default())
+            .collect();
+        all.sort_by_key(|(i, _)| *i);
+        all.into_iter().map(|(_, r)| r).collect()
+    })
 }
 
 impl Planner {
@@ -251,9 +296,59 @@ impl Planner {
             settings.starts.max(1),
             |tr| trajectory_cost(problem, tr),
         );
-        let meshes: Vec<Mesh> = starts
+        // 1. Rank every start on the coarse mesh.
+        let rank = &settings.ranking_mesh;
+        let coarse: Vec<Mesh> = starts
             .iter()
             .map(|g| {
+                Mesh::uniform(
+                    rank.points,
+                    &phase_durations(problem.t0, g),
+                    rank.interval_s,
+                    rank.min_intervals,
+                )
+            })
+            .collect();
+        let ranked = in_parallel(starts.len(), settings.threads, |i| {
+            solve_on_mesh(
+                problem,
+                &coarse[i],
+                &starts[i],
+                settings,
+                false,
+                settings.ranking_feasibility_tol,
+                deadline,
+            )
+        });
+        let mut order: Vec<(f64, usize, Trajectory)> = Vec::new();
+        let reference = ExportSettings {
+            closed_loop: false,
+            max_step_s: settings.export.max_step_s / 2.0,
+            ..settings.export
+        };
+        for (i, r) in ranked.into_iter().enumerate() {
+            let (solved, iterations, status) = r?;
+            report.iterations.push(iterations);
+            report.status = Some(status);
+            if let Some(s) = solved {
+                let mut tr = Trajectory::default();
+                export(&s.tr, &s.x, &reference, &mut tr);
+                // Rank by the path's cost re-evaluated densely: the coarse mesh's own
+                // quadrature misjudges sharp exposure transitions by percents.
+                order.push((trajectory_cost(problem, &tr), i, tr));
+            }
+        }
+        // Lowest objective first; ties go to the earlier start (deterministic).
+        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        order.truncate(settings.finalists.max(1));
+        if order.is_empty() {
+            // No start ranked (e.g. no time): try the swarm's best on the working mesh.
+            order.push((f64::INFINITY, 0, sw.best.clone()));
+        }
+        // 2. The finalists on the working mesh, from their coarse solutions.
+        let fine: Vec<Mesh> = order
+            .iter()
+            .map(|(_, _, g)| {
                 Mesh::uniform(
                     settings.mesh.points,
                     &phase_durations(problem.t0, g),
@@ -262,48 +357,28 @@ impl Planner {
                 )
             })
             .collect();
-        let threads = settings.threads.clamp(1, starts.len());
-        let results: Vec<Result<(Option<Solved>, usize, NlpStatus), PlanError>> =
-            std::thread::scope(|scope| {
-                let workers: Vec<_> = (0..threads)
-                    .map(|w| {
-                        let (starts, meshes) = (&starts, &meshes);
-                        scope.spawn(move || {
-                            (w..starts.len())
-                                .step_by(threads)
-                                .map(|i| {
-                                    (
-                                        i,
-                                        solve_on_mesh(
-                                            problem, &meshes[i], &starts[i], settings, false,
-                                            deadline,
-                                        ),
-                                    )
-                                })
-                                .collect::<Vec<_>>()
-                        })
-                    })
-                    .collect();
-                let mut all: Vec<(usize, Result<(Option<Solved>, usize, NlpStatus), PlanError>)> =
-                    workers
-                        .into_iter()
-                        .flat_map(|h| h.join().unwrap_or_default())
-                        .collect();
-                all.sort_by_key(|(i, _)| *i);
-                all.into_iter().map(|(_, r)| r).collect()
-            });
+        let finals = in_parallel(order.len(), settings.threads, |i| {
+            solve_on_mesh(
+                problem,
+                &fine[i],
+                &order[i].2,
+                settings,
+                true,
+                settings.nlp.feasibility_tol,
+                deadline,
+            )
+        });
         let mut accepted: Option<Solved> = None;
-        let mut mesh = meshes[0].clone();
-        for (i, r) in results.into_iter().enumerate() {
+        let mut mesh = fine[0].clone();
+        for (i, r) in finals.into_iter().enumerate() {
             let (solved, iterations, status) = r?;
             report.iterations.push(iterations);
             report.status = Some(status);
-            if let Some(s) = solved {
-                // Lowest objective wins; ties go to the earlier start (deterministic).
-                if accepted.as_ref().is_none_or(|a| s.objective < a.objective) {
-                    mesh = meshes[i].clone();
-                    accepted = Some(s);
-                }
+            if let Some(s) = solved
+                && accepted.as_ref().is_none_or(|a| s.objective < a.objective)
+            {
+                mesh = fine[i].clone();
+                accepted = Some(s);
             }
         }
         let mut guess = Trajectory::default();
@@ -319,14 +394,16 @@ impl Planner {
             let Some(next) = refine(&mesh, &errors, &settings.refine) else {
                 break;
             };
-            let reference = ExportSettings {
-                closed_loop: false,
-                max_step_s: settings.export.max_step_s / 2.0,
-                ..settings.export
-            };
             export(&current.tr, &current.x, &reference, &mut guess);
-            let (solved, iterations, status) =
-                solve_on_mesh(problem, &next, &guess, settings, true, deadline)?;
+            let (solved, iterations, status) = solve_on_mesh(
+                problem,
+                &next,
+                &guess,
+                settings,
+                true,
+                settings.nlp.feasibility_tol,
+                deadline,
+            )?;
             report.iterations.push(iterations);
             report.status = Some(status);
             match solved {
