@@ -27,7 +27,7 @@ fn twenty_random_scenarios_are_planned_feasibly() {
         let request = PlanRequest {
             scenario,
             seed: 1,
-            deadline: None,
+            deadline: Some(std::time::Duration::from_secs(60)),
             out_dir: root.join(&name),
         };
         let outcome = match plan_scenario(&request, clock) {
