@@ -8,7 +8,7 @@ pub mod refine;
 pub mod solve;
 pub mod transcription;
 
-pub use export::{ExportSettings, export};
+pub use export::{ExportSettings, export, fly};
 pub use lgr::Lgr;
 pub use mesh::{Layout, Mesh};
 pub use refine::{RefineSettings, interval_errors, refine};

@@ -17,7 +17,7 @@ use crate::basins;
 use crate::clock::Deadline;
 use crate::collocation::{
     ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, RefineSettings, Transcription,
-    TranscriptionSettings, export, interval_errors, refine, solve,
+    TranscriptionSettings, export, fly, interval_errors, refine, solve,
 };
 use crate::problem::Problem;
 use crate::seeding::{self, Seed};
@@ -429,7 +429,15 @@ impl Planner {
                 export(&a.tr, &a.x, &settings.export, &mut flown);
                 (a.quality, flown)
             }
-            None => (Quality::SwarmOnly, sw.best.clone()),
+            None => {
+                // The swarm's lifted path, flown with the tracking law so that its
+                // controls replay onto it (in 3-D the lifted controls alone drift away).
+                let mut flown = sw.best.resampled(settings.export.max_step_s);
+                if problem.dim() == 3 {
+                    fly(problem, &settings.export, &mut flown);
+                }
+                (Quality::SwarmOnly, flown)
+            }
         };
         if !trajectory.is_valid() {
             return Err(PlanError::NonFinite);

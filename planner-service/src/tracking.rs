@@ -106,8 +106,10 @@ impl Tracker {
         let chi_cmd = reference[4] - (g.position * dev.cross_m / v).clamp(-0.5, 0.5);
         let gamma_cmd = (gamma_r - (g.position * dev.vertical_m / v).clamp(-0.3, 0.3))
             .clamp(-l.gamma_max, l.gamma_max);
-        // Attitude loop: desired rates.
-        let gamma_rate = gamma_rate_r + g.attitude * (gamma_cmd - gamma);
+        // Attitude loop: desired rates; near the gamma limit only back inside.
+        let gamma_rate = (gamma_rate_r + g.attitude * (gamma_cmd - gamma))
+            .min(g.attitude * (l.gamma_max - gamma))
+            .max(g.attitude * (-l.gamma_max - gamma));
         let chi_rate = chi_rate_r + g.attitude * wrap_angle(chi_cmd - chi);
         // Invert gamma' = g (Nz cos mu - cos gamma) / V, chi' = g Nz sin mu / (V cos gamma).
         let vertical = v * gamma_rate / G0 + gamma.cos();
@@ -122,9 +124,14 @@ impl Tracker {
             (-lateral).atan2(-vertical)
         }
         .clamp(-l.mu_max, l.mu_max);
-        // Actuator loop.
-        let u1 = feed_forward[0] + g.actuator * (nz_cmd - nz);
-        let u2 = feed_forward[1] + g.actuator * wrap_angle(mu_cmd - mu);
+        // Actuator loop; near the Nz and bank limits only back inside (bound protection:
+        // the plan's feed-forward may push past a limit between its nodes).
+        let u1 = (feed_forward[0] + g.actuator * (nz_cmd - nz))
+            .min(g.actuator * (l.nz_max - nz))
+            .max(g.actuator * (l.nz_min - nz));
+        let u2 = (feed_forward[1] + g.actuator * wrap_angle(mu_cmd - mu))
+            .min(g.actuator * (l.mu_max - mu))
+            .max(g.actuator * (-l.mu_max - mu));
         [
             u1.clamp(-l.nz_rate_max, l.nz_rate_max),
             u2.clamp(-l.mu_rate_max, l.mu_rate_max),

@@ -68,6 +68,26 @@ impl Trajectory {
         ))
     }
 
+    /// The trajectory linearly interpolated on a uniform grid of at most `step` (keeping
+    /// the first and last time and the phase ends).
+    pub fn resampled(&self, step: f64) -> Trajectory {
+        let mut out = Trajectory {
+            phase_ends: self.phase_ends.clone(),
+            ..Trajectory::default()
+        };
+        let (Some(&t0), Some(tf)) = (self.times.first(), self.final_time()) else {
+            return out;
+        };
+        let n = ((tf - t0) / step).ceil().max(1.0) as usize;
+        for k in 0..=n {
+            let t = t0 + (tf - t0) * k as f64 / n as f64;
+            if let Some((x, u)) = self.at(t) {
+                out.push(t, x, u);
+            }
+        }
+        out
+    }
+
     /// Whether every number is finite and the times strictly increase.
     pub fn is_valid(&self) -> bool {
         let n = self.times.len();

@@ -129,14 +129,17 @@ pub fn export(tr: &Transcription, x: &[f64], settings: &ExportSettings, out: &mu
         }
     }
     if settings.closed_loop && tr.nu == 2 {
-        fly(tr, settings, out);
+        fly(&tr.problem, settings, out);
     }
 }
 
 /// Replaces the reference samples in `out` by the states flown and the controls applied
-/// by the tracking law following them (see the module documentation).
-fn fly(tr: &Transcription, settings: &ExportSettings, out: &mut Trajectory) {
-    let tracker = Tracker::new(&tr.problem, settings.gains);
+/// by the tracking law following them, from the reference's first state (see the module
+/// documentation). Any sampled trajectory of `problem` can be flown this way (e.g. the
+/// swarm's lifted path when the NLP had no time).
+pub fn fly(problem: &crate::problem::Problem, settings: &ExportSettings, out: &mut Trajectory) {
+    let vehicle = Vehicle::new(problem);
+    let tracker = Tracker::new(problem, settings.gains);
     let n = out.len();
     let reference = out.states.clone();
     let feed_forward = out.controls.clone();
@@ -145,9 +148,9 @@ fn fly(tr: &Transcription, settings: &ExportSettings, out: &mut Trajectory) {
     out.controls[0] = u;
     for k in 0..n - 1 {
         let dt = out.times[k + 1] - out.times[k];
-        let predicted = integrate(&tr.vehicle, &x, &u, &u, dt, settings.integration_step_s);
+        let predicted = integrate(&vehicle, &x, &u, &u, dt, settings.integration_step_s);
         let next = tracker.control(&predicted, &reference[k + 1], &feed_forward[k + 1]);
-        x = integrate(&tr.vehicle, &x, &u, &next, dt, settings.integration_step_s);
+        x = integrate(&vehicle, &x, &u, &next, dt, settings.integration_step_s);
         u = next;
         out.states[k + 1] = x;
         out.controls[k + 1] = u;
