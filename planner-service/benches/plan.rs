@@ -39,11 +39,22 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let runs: u64 = args.iter().position(|a| a == "--runs").and_then(|i| args.get(i + 1)).and_then(|v| v.parse().ok()).unwrap_or(20);
-    let only = args.iter().position(|a| a == "--only").and_then(|i| args.get(i + 1)).cloned();
+    let runs: u64 = args
+        .iter()
+        .position(|a| a == "--runs")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(20);
+    let only = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1))
+        .cloned();
     let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
     let settings = PlannerSettings::default();
-    println!("| scenario | median ms | p95 ms | swarm % | NLP % | rest % | cost min | cost max | spread % | peak heap MiB | quality |");
+    println!(
+        "| scenario | median ms | p95 ms | swarm % | NLP % | rest % | cost min | cost max | spread % | peak heap MiB | quality |"
+    );
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     for (name, _) in BUNDLED {
         if only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
@@ -62,7 +73,13 @@ fn main() {
                 ..settings.clone()
             };
             let mut planner = Planner::new(&s);
-            let out = planner.plan(&problem, &s, Deadline::after(clock, Duration::from_secs(30))).unwrap();
+            let out = planner
+                .plan(
+                    &problem,
+                    &s,
+                    Deadline::after(clock, Duration::from_secs(30)),
+                )
+                .unwrap();
             let t = out.times.total.as_secs_f64() * 1e3;
             times.push(t);
             swarm += out.times.swarm.as_secs_f64() * 1e3;
@@ -83,7 +100,11 @@ fn main() {
             100.0 * nlp / total,
             100.0 * (total - swarm - nlp) / total,
             100.0 * (hi - lo) / lo.abs().max(1e-12),
-            qualities.iter().map(|(q, n)| format!("{q} {n}")).collect::<Vec<_>>().join(", "),
+            qualities
+                .iter()
+                .map(|(q, n)| format!("{q} {n}"))
+                .collect::<Vec<_>>()
+                .join(", "),
         );
     }
     // Deadline overshoot: a budget far too short for the NLP.
@@ -104,12 +125,22 @@ fn main() {
                 };
                 let mut planner = Planner::new(&s);
                 let began = clock.now();
-                let out = planner.plan(&problem, &s, Deadline::after(clock, Duration::from_millis(budget_ms))).unwrap();
+                let out = planner
+                    .plan(
+                        &problem,
+                        &s,
+                        Deadline::after(clock, Duration::from_millis(budget_ms)),
+                    )
+                    .unwrap();
                 over.push((clock.now() - began).as_secs_f64() * 1e3);
                 quality = format!("{:?}", out.quality);
             }
             over.sort_by(f64::total_cmp);
-            println!("| {name} | {budget_ms} | {:.1} / {:.1} | {quality} (last) |", percentile(&over, 0.5), over[over.len() - 1]);
+            println!(
+                "| {name} | {budget_ms} | {:.1} / {:.1} | {quality} (last) |",
+                percentile(&over, 0.5),
+                over[over.len() - 1]
+            );
         }
     }
 }

@@ -45,8 +45,14 @@ pub fn plan_scenario(
     let outcome = planner.plan(&problem, &settings, Deadline::after(clock, budget))?;
     std::fs::create_dir_all(&request.out_dir)?;
     write_outputs(&request.out_dir, &request.scenario, &problem, &outcome)?;
-    draw_plan(&request.out_dir.join("plan.png"), &request.scenario, &problem, &planner, &outcome)
-        .map_err(|e| anyhow::anyhow!("drawing plan.png: {e}"))?;
+    draw_plan(
+        &request.out_dir.join("plan.png"),
+        &request.scenario,
+        &problem,
+        &planner,
+        &outcome,
+    )
+    .map_err(|e| anyhow::anyhow!("drawing plan.png: {e}"))?;
     Ok(outcome)
 }
 
@@ -74,7 +80,9 @@ fn draw_plan(
         let tf = o.trajectory.final_time().unwrap_or(problem.t0);
         let points = (0..=100)
             .map(|k| {
-                let p = lead.at(problem.t0 + (tf - problem.t0) * k as f64 / 100.0).position;
+                let p = lead
+                    .at(problem.t0 + (tf - problem.t0) * k as f64 / 100.0)
+                    .position;
                 [p[0], p[1]]
             })
             .collect();
@@ -92,7 +100,11 @@ fn draw_plan(
         points: o.swarm_best.states.iter().map(xy).collect(),
     });
     paths.push(MapPath {
-        label: Some(format!("plan, {} (cost {:.4})", quality_name(o.quality), o.cost)),
+        label: Some(format!(
+            "plan, {} (cost {:.4})",
+            quality_name(o.quality),
+            o.cost
+        )),
         color: RGBColor(20, 70, 200),
         stroke: Stroke::Bold,
         points: o.trajectory.states.iter().map(xy).collect(),

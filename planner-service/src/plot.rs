@@ -91,13 +91,23 @@ fn static_footprints(problem: &Problem) -> Vec<Vec<[f64; 2]>> {
 
 fn moving_roads(problem: &Problem) -> Vec<Vec<[f64; 2]>> {
     match &problem.threats {
-        Threats::Planar { moving, .. } => moving.iter().map(|m| m.road().points().iter().map(|p| [p[0], p[1]]).collect()).collect(),
-        Threats::Spatial { moving, .. } => moving.iter().map(|m| m.road().points().iter().map(|p| [p[0], p[1]]).collect()).collect(),
+        Threats::Planar { moving, .. } => moving
+            .iter()
+            .map(|m| m.road().points().iter().map(|p| [p[0], p[1]]).collect())
+            .collect(),
+        Threats::Spatial { moving, .. } => moving
+            .iter()
+            .map(|m| m.road().points().iter().map(|p| [p[0], p[1]]).collect())
+            .collect(),
     }
 }
 
 /// Draws `plot` into a PNG of `size` pixels.
-pub fn draw_map(path: &Path, plot: &MapPlot<'_>, size: (u32, u32)) -> Result<(), Box<dyn std::error::Error>> {
+pub fn draw_map(
+    path: &Path,
+    plot: &MapPlot<'_>,
+    size: (u32, u32),
+) -> Result<(), Box<dyn std::error::Error>> {
     register_font();
     let footprints = static_footprints(plot.problem);
     let roads = moving_roads(plot.problem);
@@ -110,7 +120,10 @@ pub fn draw_map(path: &Path, plot: &MapPlot<'_>, size: (u32, u32)) -> Result<(),
             hi[i] = hi[i].max(p[i]);
         }
     };
-    plot.paths.iter().flat_map(|p| &p.points).for_each(&mut grow);
+    plot.paths
+        .iter()
+        .flat_map(|p| &p.points)
+        .for_each(&mut grow);
     plot.markers.iter().for_each(|m| grow(&m.at));
     footprints.iter().flatten().for_each(&mut grow);
     if !lo[0].is_finite() {
@@ -119,7 +132,12 @@ pub fn draw_map(path: &Path, plot: &MapPlot<'_>, size: (u32, u32)) -> Result<(),
     }
     let span = (hi[0] - lo[0]).max(hi[1] - lo[1]) * 0.05 + 1000.0;
     let km = |v: f64| v / 1000.0;
-    let (x0, x1, y0, y1) = (km(lo[0] - span), km(hi[0] + span), km(lo[1] - span), km(hi[1] + span));
+    let (x0, x1, y0, y1) = (
+        km(lo[0] - span),
+        km(hi[0] + span),
+        km(lo[1] - span),
+        km(hi[1] + span),
+    );
 
     let root = BitMapBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE)?;
@@ -141,29 +159,46 @@ pub fn draw_map(path: &Path, plot: &MapPlot<'_>, size: (u32, u32)) -> Result<(),
     let threat_edge = RGBColor(200, 40, 30);
     for (k, fp) in footprints.iter().enumerate() {
         let pts: Vec<(f64, f64)> = fp.iter().map(|p| (km(p[0]), km(p[1]))).collect();
-        chart.draw_series(std::iter::once(Polygon::new(pts.clone(), threat_fill.filled())))?;
-        let series = chart.draw_series(std::iter::once(PathElement::new(pts, threat_edge.stroke_width(1))))?;
+        chart.draw_series(std::iter::once(Polygon::new(
+            pts.clone(),
+            threat_fill.filled(),
+        )))?;
+        let series = chart.draw_series(std::iter::once(PathElement::new(
+            pts,
+            threat_edge.stroke_width(1),
+        )))?;
         if k == 0 {
-            series
-                .label("static threat (F = 1)")
-                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 16, y + 5)], threat_fill.filled()));
+            series.label("static threat (F = 1)").legend(move |(x, y)| {
+                Rectangle::new([(x, y - 5), (x + 16, y + 5)], threat_fill.filled())
+            });
         }
     }
     for (k, road) in roads.iter().enumerate() {
         let pts: Vec<(f64, f64)> = road.iter().map(|p| (km(p[0]), km(p[1]))).collect();
-        let s = chart.draw_series(std::iter::once(PathElement::new(pts, RGBColor(120, 80, 20).stroke_width(3))))?;
+        let s = chart.draw_series(std::iter::once(PathElement::new(
+            pts,
+            RGBColor(120, 80, 20).stroke_width(3),
+        )))?;
         if k == 0 {
-            s.label("road of a moving threat")
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RGBColor(120, 80, 20).stroke_width(3)));
+            s.label("road of a moving threat").legend(|(x, y)| {
+                PathElement::new(
+                    vec![(x, y), (x + 16, y)],
+                    RGBColor(120, 80, 20).stroke_width(3),
+                )
+            });
         }
     }
     for (label, color, outline) in &plot.outlines {
         let pts: Vec<(f64, f64)> = outline.iter().map(|p| (km(p[0]), km(p[1]))).collect();
         let color = *color;
-        let s = chart.draw_series(std::iter::once(PathElement::new(pts, color.stroke_width(2))))?;
+        let s = chart.draw_series(std::iter::once(PathElement::new(
+            pts,
+            color.stroke_width(2),
+        )))?;
         if !label.is_empty() {
-            s.label(label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+            s.label(label.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2))
+            });
         }
     }
     for p in &plot.paths {
@@ -186,7 +221,11 @@ pub fn draw_map(path: &Path, plot: &MapPlot<'_>, size: (u32, u32)) -> Result<(),
     }
     for m in &plot.markers {
         let color = m.color;
-        chart.draw_series(std::iter::once(Circle::new((km(m.at[0]), km(m.at[1])), 5, color.filled())))?;
+        chart.draw_series(std::iter::once(Circle::new(
+            (km(m.at[0]), km(m.at[1])),
+            5,
+            color.filled(),
+        )))?;
         chart.draw_series(std::iter::once(Text::new(
             m.label.clone(),
             (km(m.at[0]), km(m.at[1])),

@@ -295,7 +295,8 @@ impl Problem {
             return bad("targets must be finite".into());
         }
         let w = &self.weights;
-        let weights_ok = (0.0..=1.0).contains(&w.alpha) && (0.0..=1.0).contains(&w.beta) && w.stiffness > 0.0;
+        let weights_ok =
+            (0.0..=1.0).contains(&w.alpha) && (0.0..=1.0).contains(&w.beta) && w.stiffness > 0.0;
         if !weights_ok {
             return bad("weights: alpha and beta must be in [0, 1], stiffness positive".into());
         }

@@ -106,10 +106,8 @@ impl Tracker {
         let chi_cmd = reference[4] - (g.position * dev.cross_m / v).clamp(-0.5, 0.5);
         let gamma_cmd = (gamma_r - (g.position * dev.vertical_m / v).clamp(-0.3, 0.3))
             .clamp(-l.gamma_max, l.gamma_max);
-        // Attitude loop: desired rates; near the gamma limit only back inside.
-        let gamma_rate = (gamma_rate_r + g.attitude * (gamma_cmd - gamma))
-            .min(g.attitude * (l.gamma_max - gamma))
-            .max(g.attitude * (-l.gamma_max - gamma));
+        // Attitude loop: desired rates.
+        let gamma_rate = gamma_rate_r + g.attitude * (gamma_cmd - gamma);
         let chi_rate = chi_rate_r + g.attitude * wrap_angle(chi_cmd - chi);
         // Invert gamma' = g (Nz cos mu - cos gamma) / V, chi' = g Nz sin mu / (V cos gamma).
         let vertical = v * gamma_rate / G0 + gamma.cos();
