@@ -19,13 +19,26 @@ use wingman_planner::scenario::{self, BUNDLED};
 use wingman_planner::swarm::{self, SwarmSettings, SwarmWorkspace};
 use wingman_planner::trajectory::Trajectory;
 
+/// One scenario of the summary line.
+struct Row {
+    spatial: bool,
+    median_ms: f64,
+    /// The first run's objective over the reference cost.
+    first: f64,
+    /// The mean over the runs of the same.
+    mean: f64,
+}
+
 fn env<T: std::str::FromStr>(name: &str) -> Option<T> {
     std::env::var(name).ok().and_then(|v| v.parse().ok())
 }
 
 /// `cost = ...` of each `[scenario]` table of the reference's costs.toml.
 fn reference_costs() -> Vec<(String, f64)> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/reference/costs.toml");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/reference/costs.toml"
+    );
     let Ok(text) = std::fs::read_to_string(path) else {
         return Vec::new();
     };
@@ -136,7 +149,7 @@ fn main() {
         "tf s",
         "passes m"
     );
-    let mut summary: Vec<(bool, f64, f64, f64)> = Vec::new();
+    let mut summary: Vec<Row> = Vec::new();
     for (name, _) in BUNDLED {
         if only.as_deref().is_some_and(|o| !name.contains(o)) {
             continue;
@@ -160,9 +173,17 @@ fn main() {
             match out {
                 Ok(o) => {
                     objectives.push(o.report.objective);
-                    if let (Some(dir), true) = (&export, std::env::var("SWARM_EXPORT_ALL").is_ok()) {
+                    if let (Some(dir), true) = (&export, std::env::var("SWARM_EXPORT_ALL").is_ok())
+                    {
                         let _ = std::fs::create_dir_all(dir);
                         let _ = write_csv(&format!("{dir}/{name}.r{r}.csv"), sc.model, &o.best);
+                        for (k, c) in o.candidates.iter().enumerate() {
+                            let _ = write_csv(
+                                &format!("{dir}/{name}.r{r}.c{k}.csv"),
+                                sc.model,
+                                &c.trajectory,
+                            );
+                        }
                     }
                     if first.is_none() {
                         first = Some(o);
@@ -178,7 +199,11 @@ fn main() {
             let _ = write_csv(&format!("{dir}/{name}.csv"), sc.model, &o.best);
             if std::env::var("SWARM_EXPORT_CANDIDATES").is_ok() {
                 for (k, c) in o.candidates.iter().enumerate() {
-                    let _ = write_csv(&format!("{dir}/{name}.cand{k}={:.4}.csv", c.cost), sc.model, &c.trajectory);
+                    let _ = write_csv(
+                        &format!("{dir}/{name}.cand{k}={:.4}.csv", c.cost),
+                        sc.model,
+                        &c.trajectory,
+                    );
                 }
                 let _ = std::fs::write(format!("{dir}/{name}.best_cost"), format!("{}", o.cost));
             }
@@ -188,7 +213,7 @@ fn main() {
                 let _ = std::fs::create_dir_all(&sdir);
                 for i in 0..ws.seeds().len() {
                     let label = ws.seeds()[i].label().to_string().replace('/', "_");
-                    if let Some((cost, _, t)) = ws.seed_trajectory(i, base.lookahead) {
+                    if let Some((cost, _, t)) = ws.seed_trajectory(i) {
                         let _ = write_csv(&format!("{sdir}/{label}={cost:.4}.csv"), sc.model, &t);
                     }
                 }
@@ -200,12 +225,12 @@ fn main() {
         if let Some(c) = reference
             && c > 1e-2
         {
-            summary.push((
-                sc.model == Model::ThreeD,
-                percentile(&times, 0.5).as_secs_f64() * 1e3,
-                o.report.objective / c,
-                objectives.iter().map(|j| j / c).sum::<f64>() / objectives.len() as f64,
-            ));
+            summary.push(Row {
+                spatial: sc.model == Model::ThreeD,
+                median_ms: percentile(&times, 0.5).as_secs_f64() * 1e3,
+                first: o.report.objective / c,
+                mean: objectives.iter().map(|j| j / c).sum::<f64>() / objectives.len() as f64,
+            });
         }
         let passes: Vec<String> = o.report.pass_distances[..o.report.phases]
             .iter()
@@ -221,7 +246,11 @@ fn main() {
             o.report.objective,
             reference.unwrap_or(f64::NAN),
             reference.map_or(f64::NAN, |c| o.report.objective / c),
-            if lo.abs() > 0.0 { (hi - lo) / lo.abs() } else { 0.0 },
+            if lo.abs() > 0.0 {
+                (hi - lo) / lo.abs()
+            } else {
+                0.0
+            },
             o.seeds_best_cost / o.cost,
             o.report.final_time,
             passes.join("/"),
@@ -229,19 +258,17 @@ fn main() {
         );
     }
     for (label, three) in [("2-D", false), ("3-D", true)] {
-        let rows: Vec<_> = summary.iter().filter(|r| r.0 == three).collect();
+        let rows: Vec<&Row> = summary.iter().filter(|r| r.spatial == three).collect();
         if rows.is_empty() {
             continue;
         }
         let n = rows.len() as f64;
-        let geo = |f: &dyn Fn(&(bool, f64, f64, f64)) -> f64| {
-            (rows.iter().map(|r| f(r).ln()).sum::<f64>() / n).exp()
-        };
+        let geo = |f: fn(&Row) -> f64| (rows.iter().map(|r| f(r).ln()).sum::<f64>() / n).exp();
         println!(
             "{label}: max median {:.1} ms, geomean J/ref first run {:.4}, over all runs {:.4} (scenarios with ref J > 0.01)",
-            rows.iter().map(|r| r.1).fold(0.0, f64::max),
-            geo(&|r| r.2),
-            geo(&|r| r.3),
+            rows.iter().map(|r| r.median_ms).fold(0.0, f64::max),
+            geo(|r| r.first),
+            geo(|r| r.mean),
         );
     }
 }

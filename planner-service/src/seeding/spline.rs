@@ -36,6 +36,8 @@ impl Spline2 {
     /// least 1e-6 apart), leaving the first point along `start_heading` and arriving at the
     /// last along `end_heading` (radians, counter-clockwise from +x). `None` when the
     /// points do not qualify.
+    // The indices follow the tridiagonal system's notation (rows, coordinates).
+    #[allow(clippy::needless_range_loop)]
     pub(crate) fn new(points: &[[f64; 2]], start_heading: f64, end_heading: f64) -> Option<Self> {
         let n = points.len();
         if !(2..=MAX_NODES).contains(&n) {
@@ -139,10 +141,10 @@ impl Spline2 {
         let d11 = 3.0 * f2 - 2.0 * f;
         let (a, b) = (&self.p[i], &self.p[i + 1]);
         let (ma, mb) = (&self.m[i], &self.m[i + 1]);
-        let pos = std::array::from_fn(|c| h00 * a[c] + h10 * h * ma[c] + h01 * b[c] + h11 * h * mb[c]);
-        let der = std::array::from_fn(|c| {
-            (d00 * a[c] + d01 * b[c]) / h + d10 * ma[c] + d11 * mb[c]
-        });
+        let pos =
+            std::array::from_fn(|c| h00 * a[c] + h10 * h * ma[c] + h01 * b[c] + h11 * h * mb[c]);
+        let der =
+            std::array::from_fn(|c| (d00 * a[c] + d01 * b[c]) / h + d10 * ma[c] + d11 * mb[c]);
         (pos, der)
     }
 
@@ -175,7 +177,12 @@ mod tests {
     /// is C¹ at interior nodes (1e-9 relative).
     #[test]
     fn interpolates_with_clamped_ends() {
-        let pts = [[0.0, 0.0], [1000.0, 800.0], [3000.0, 1000.0], [4000.0, -500.0]];
+        let pts = [
+            [0.0, 0.0],
+            [1000.0, 800.0],
+            [3000.0, 1000.0],
+            [4000.0, -500.0],
+        ];
         let s = Spline2::new(&pts, 1.2, -0.7).unwrap();
         for i in 0..3 {
             let (a, _) = s.eval(i, 0.0);
@@ -214,8 +221,12 @@ mod tests {
     /// A straight two-node spline along its own direction has the chord's length (1e-9).
     #[test]
     fn straight_length() {
-        let s = Spline2::new(&[[0.0, 0.0], [3000.0, 4000.0]], 0.927_295_218_001_612_2, 0.927_295_218_001_612_2)
-            .unwrap();
+        let s = Spline2::new(
+            &[[0.0, 0.0], [3000.0, 4000.0]],
+            0.927_295_218_001_612_2,
+            0.927_295_218_001_612_2,
+        )
+        .unwrap();
         assert!((s.segment_length(0) - 5000.0).abs() < 1e-6);
     }
 }

@@ -1,15 +1,18 @@
 //! The swarm's per-run constants ([`Grid`]: time grid, bounds, targets, penalty weights,
 //! caches of the lead's positions and the moving threats' regions at every sample time)
-//! and everything done to one particle: fly it ([`simulate`]), find where it passes each
-//! target and the end, and price it ([`evaluate`]); turn a seed into a particle
-//! ([`track`]); write the best particle out as a full-model [`Trajectory`].
+//! and everything done to one particle: fly it and price it ([`evaluate`]: the flight,
+//! the passes of the targets and the end found on the fly, the cost), turn a seed into a
+//! particle ([`track`]), write a particle out as a full-model [`Trajectory`]
+//! ([`write_trajectory`]).
 //!
 //! Particle layout (see the `swarm` module documentation): control step `k` of length
-//! `dt` holds `nu` coordinates at `k * nu ..`:
-//! - 2-D: the turn rate `u_k`, held over the step and flown as exact circular arcs;
-//! - 3-D: the flight-path angle reached at the step's end `gamma_{k+1}` and the heading
-//!   rate `chi'_k`; within a step `gamma` and `chi` are linear in time, so the lifted `Nz`,
-//!   `mu` (eqs. 5.13–5.14) are constant per step.
+//! `dt` holds `nu` coordinates at `k * nu ..`, held over the step's `sub` samples of length
+//! `h`; at every sample the control flown is the guidance command plus the coordinate
+//! (guided) or the coordinate itself (direct), clamped:
+//! - 2-D: a turn rate, flown as an exact circular arc per sample;
+//! - 3-D: the flight-path angle at the sample's end (`gamma` linear over the sample) at
+//!   index `2k`, the heading rate at `2k + 1`; the lifted `Nz`, `mu` (eqs. 5.13–5.14) are
+//!   constant per sample.
 //!
 //! Nothing here allocates: every buffer lives in [`Grid`] or [`Scratch`], sized once.
 
@@ -32,6 +35,9 @@ pub(crate) struct CachedRegion<const D: usize> {
     active: bool,
 }
 
+/// The static threats, held inline: one per grid, read at every sample (a box would add
+/// an indirection to the hot path for no saving).
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy)]
 enum Layout {
     /// Before the first [`Grid::prepare`].
@@ -44,7 +50,11 @@ enum Layout {
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum End {
     /// The final point (fixed-time, min-time).
-    Point { p: [f64; 3], heading: f64, gamma: f64 },
+    Point {
+        p: [f64; 3],
+        heading: f64,
+        gamma: f64,
+    },
     /// The lead (rendezvous).
     Lead,
 }
@@ -199,7 +209,11 @@ impl Grid {
             self.nz0 = x0[5];
             self.mu0 = x0[6];
             // Fastest coordinated level turn: bank at mu_max, or at the load factor limit.
-            let tan_mu = l.mu_max.min(1.5).tan().min((l.nz_max * l.nz_max - 1.0).max(0.0).sqrt());
+            let tan_mu = l
+                .mu_max
+                .min(1.5)
+                .tan()
+                .min((l.nz_max * l.nz_max - 1.0).max(0.0).sqrt());
             self.rate_max = G0 * tan_mu / l.speed;
             self.gamma_max = l.gamma_max;
             self.z_min = l.z_min;
@@ -320,30 +334,28 @@ impl Grid {
         }
     }
 
-    /// Where the wingman at `p` meets the lead flying on from time `t` at its current
-    /// velocity: `L + v tau` with `|L + v tau - p| = V tau` (the positive root of the
-    /// quadratic; the lead's position when the lead is not slower).
+    /// Where the wingman at `p` meets the lead flying on from sample `j` at its velocity
+    /// there: `L + v tau` with `|L + v tau - p| = V tau` (the positive root of the
+    /// quadratic; the lead's position when the lead is not slower). `L` and `v` come from
+    /// the cached lead positions at the sample times (`v` by their difference).
     #[inline]
-    fn intercept(&self, p: &[f64; 3], t: f64) -> [f64; 3] {
-        let Some(lead) = &self.lead else {
+    fn intercept(&self, p: &[f64; 3], j: usize) -> [f64; 3] {
+        let n = self.lead_pos.len();
+        if n < 2 {
             return *p;
-        };
-        let lp = lead.at(t);
-        let z = if self.spatial { 1.0 } else { 0.0 };
-        let r = [lp.position[0] - p[0], lp.position[1] - p[1], z * (lp.position[2] - p[2])];
-        let v = [lp.velocity[0], lp.velocity[1], z * lp.velocity[2]];
+        }
+        let j = j.min(n - 2);
+        let (l, l1) = (self.lead_pos[j], self.lead_pos[j + 1]);
+        let v: [f64; 3] = std::array::from_fn(|k| (l1[k] - l[k]) / self.h);
+        let r: [f64; 3] = std::array::from_fn(|k| l[k] - p[k]);
         let a = v[0] * v[0] + v[1] * v[1] + v[2] * v[2] - self.speed * self.speed;
         let b = 2.0 * (r[0] * v[0] + r[1] * v[1] + r[2] * v[2]);
         let c = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
         if a >= 0.0 {
-            return [lp.position[0], lp.position[1], z * lp.position[2]];
+            return l;
         }
         let tau = (b + (b * b - 4.0 * a * c).max(0.0).sqrt()) / (-2.0 * a);
-        [
-            lp.position[0] + v[0] * tau,
-            lp.position[1] + v[1] * tau,
-            z * (lp.position[2] + v[2] * tau),
-        ]
+        std::array::from_fn(|k| l[k] + v[k] * tau)
     }
 
     /// Exposure at sample `j` (time `t0 + j h`) and position `p`: the same arithmetic as
@@ -487,6 +499,48 @@ fn sinc(x: f64) -> f64 {
     }
 }
 
+/// `(sin x, cos x)` for the small angles of one sample step (a half turn-rate or
+/// flight-path increment): Taylor series to `x^10` when `|x| <= 0.6` (error below 1e-10,
+/// several times cheaper than `sin_cos`), `sin_cos` otherwise.
+#[inline(always)]
+fn sin_cos_small(x: f64) -> (f64, f64) {
+    if x.abs() > 0.6 {
+        return x.sin_cos();
+    }
+    // Horner form with the reciprocal factorial ratios as constants (no division).
+    const S3: f64 = 1.0 / 6.0;
+    const S5: f64 = 1.0 / 20.0;
+    const S7: f64 = 1.0 / 42.0;
+    const S9: f64 = 1.0 / 72.0;
+    const C2: f64 = 0.5;
+    const C4: f64 = 1.0 / 12.0;
+    const C6: f64 = 1.0 / 30.0;
+    const C8: f64 = 1.0 / 56.0;
+    const C10: f64 = 1.0 / 90.0;
+    let x2 = x * x;
+    let s = x * (1.0 - x2 * S3 * (1.0 - x2 * S5 * (1.0 - x2 * S7 * (1.0 - x2 * S9))));
+    let c = 1.0 - x2 * C2 * (1.0 - x2 * C4 * (1.0 - x2 * C6 * (1.0 - x2 * C8 * (1.0 - x2 * C10))));
+    (s, c)
+}
+
+/// `atan(z)` within 1e-5 rad (minimax polynomial on `[-1, 1]`, `pi/2 - atan(1/z)`
+/// beyond): for the guidance's flight-path angle and the effort estimate, not for output.
+#[inline(always)]
+fn atan_fast(z: f64) -> f64 {
+    let (a, flip) = if z.abs() > 1.0 {
+        (1.0 / z, true)
+    } else {
+        (z, false)
+    };
+    let a2 = a * a;
+    let r = a
+        * (0.999_977_26
+            + a2 * (-0.332_623_47
+                + a2 * (0.193_543_46
+                    + a2 * (-0.116_432_87 + a2 * (0.052_653_32 - 0.011_721_20 * a2)))));
+    if flip { FRAC_PI_2.copysign(z) - r } else { r }
+}
+
 /// `(sin, cos)` of `a + b` from those of `a` and `b`.
 #[inline(always)]
 fn rotate((sa, ca): (f64, f64), (sb, cb): (f64, f64)) -> (f64, f64) {
@@ -521,8 +575,14 @@ impl State {
 #[inline(always)]
 fn step_planar(g: &Grid, s: &mut State, u: f64) {
     let uh = u * g.h;
-    let half = (0.5 * uh).sin_cos();
-    let chord = g.speed * g.h * if uh.abs() < 2e-4 { sinc(0.5 * uh) } else { half.0 / (0.5 * uh) };
+    let half = sin_cos_small(0.5 * uh);
+    let chord = g.speed
+        * g.h
+        * if uh.abs() < 2e-4 {
+            sinc(0.5 * uh)
+        } else {
+            half.0 / (0.5 * uh)
+        };
     let mid = rotate(s.sc_head, half);
     s.p[0] += chord * mid.1;
     s.p[1] += chord * mid.0;
@@ -551,7 +611,7 @@ fn spatial_controls(g: &Grid, s: &State, gamma_cmd: f64, rate: f64) -> (f64, f64
 fn step_spatial(g: &Grid, s: &mut State, ge: f64, w: f64) {
     let dchi = w * g.h;
     let dgam = ge - s.gam;
-    let (hc, hg) = ((0.5 * dchi).sin_cos(), (0.5 * dgam).sin_cos());
+    let (hc, hg) = (sin_cos_small(0.5 * dchi), sin_cos_small(0.5 * dgam));
     let mc = rotate(s.sc_head, hc);
     let mg = rotate(s.sc_gam, hg);
     let vh = g.speed * g.h;
@@ -565,7 +625,8 @@ fn step_spatial(g: &Grid, s: &mut State, ge: f64, w: f64) {
 }
 
 /// `Nz`, `mu` of a 3-D sample step (eq. 5.14 as [`dynamics::lift_reduced_path`], in the
-/// form `mu = atan(num / den)`, `Nz = sign(den) (V / g) sqrt(num² + den²)`).
+/// form `mu = atan(num / den)`, `Nz = sign(den) (V / g) sqrt(num² + den²)`, `atan` within
+/// 1e-5 rad: for the swarm's effort term only).
 #[inline(always)]
 fn lift_step(g: &Grid, s: &State, ge: f64, w: f64) -> (f64, f64) {
     let gdot = (ge - s.gam) / g.h;
@@ -576,7 +637,7 @@ fn lift_step(g: &Grid, s: &State, ge: f64, w: f64) -> (f64, f64) {
     if den == 0.0 {
         (0.0, num.signum() * FRAC_PI_2)
     } else {
-        (den.signum() * g.speed / G0 * r, (num / den).atan())
+        (den.signum() * g.speed / G0 * r, atan_fast(num / den))
     }
 }
 
@@ -585,9 +646,10 @@ fn lift_step(g: &Grid, s: &State, ge: f64, w: f64) -> (f64, f64) {
 /// 3-D, the flight-path angle of the straight climb to it, both clamped to their bounds.
 /// In 2-D the arc is flown exactly, so a reachable aim point is hit. An aim point inside
 /// the tightest turning circle on its side cannot be reached by turning (pursuit would
-/// orbit it for ever): the command is then to fly straight until it is outside.
+/// orbit it for ever): the command is then to fly straight until it is outside. `turn`
+/// remembers the side of a turn towards a point behind (hysteresis).
 #[inline(always)]
-fn pursuit(g: &Grid, s: &State, aim: &[f64; 3]) -> (f64, f64) {
+fn pursuit(g: &Grid, s: &State, aim: &[f64; 3], turn: &mut i8) -> (f64, f64) {
     let (dx, dy) = (aim[0] - s.p[0], aim[1] - s.p[1]);
     let d2 = dx * dx + dy * dy;
     let (sh, ch) = s.sc_head;
@@ -600,12 +662,18 @@ fn pursuit(g: &Grid, s: &State, aim: &[f64; 3]) -> (f64, f64) {
     let rate = if d2 < 1.0 || d2 < 2.0 * radius * cross.abs() {
         0.0
     } else if dot < 0.0 {
-        if cross >= 0.0 { g.rate_max } else { -g.rate_max }
+        // Behind: turn towards it at the full rate; within 30 degrees of straight behind,
+        // keep the side chosen before (else the side flips at every sample).
+        if *turn == 0 || cross.abs() > 0.5 * d2.sqrt() {
+            *turn = if cross >= 0.0 { 1 } else { -1 };
+        }
+        f64::from(*turn) * g.rate_max
     } else {
+        *turn = 0;
         2.0 * vh * cross / d2
     };
     let gamma = if g.spatial {
-        (aim[2] - s.p[2]).atan2(d2.sqrt().max(1.0))
+        atan_fast((aim[2] - s.p[2]) / d2.sqrt().max(1.0))
     } else {
         0.0
     };
@@ -622,12 +690,13 @@ fn pursuit(g: &Grid, s: &State, aim: &[f64; 3]) -> (f64, f64) {
 #[derive(Debug, Clone, Copy, Default)]
 struct Guide {
     gate: usize,
+    turn: i8,
 }
 
 impl Guide {
-    /// The guidance command (heading rate, flight-path angle) at state `s` and time `t`.
+    /// The guidance command (heading rate, flight-path angle) at state `s` at sample `j`.
     #[inline(always)]
-    fn command(&mut self, g: &Grid, s: &State, t: f64) -> (f64, f64) {
+    fn command(&mut self, g: &Grid, s: &State, j: usize) -> (f64, f64) {
         if !g.guided {
             return (0.0, 0.0);
         }
@@ -649,10 +718,10 @@ impl Guide {
         } else {
             match g.end {
                 End::Point { p, .. } => p,
-                End::Lead => g.intercept(&s.p, t),
+                End::Lead => g.intercept(&s.p, j),
             }
         };
-        pursuit(g, s, &aim)
+        pursuit(g, s, &aim, &mut self.turn)
     }
 }
 
@@ -689,7 +758,7 @@ impl Flyer {
     fn step(&mut self, g: &Grid, u: &[f64], k: usize, sc: &mut Scratch) {
         for _ in 0..g.sub {
             let j = self.j;
-            let (cr, cg) = self.guide.command(g, &self.s, g.time(j));
+            let (cr, cg) = self.guide.command(g, &self.s, j);
             if !g.spatial {
                 let ue = (cr + u[k]).clamp(-g.rate_max, g.rate_max);
                 sc.ctrl[j] = ue;
@@ -1022,9 +1091,9 @@ pub(crate) fn evaluate(g: &Grid, u: &[f64], sc: &mut Scratch) -> Report {
 /// gives the commands, whose mean (guided: mean offset from the guidance command) is the
 /// particle's coordinate for the step; the step is then flown again exactly as the
 /// particle will fly it, and pursuit goes on from there, so the particle reproduces the
-/// tracked path (clamps and altitude guard included). The aim point is `lookahead * V *
-/// dt` ahead along the seed, but never past the next target or the end until that is
-/// passed (pursuit then flies the arc through it).
+/// tracked path (clamps and altitude guard included). The aim point is `lookahead * V`
+/// ahead along the seed (`lookahead` in seconds), but never past the next target or the
+/// end until that is passed (pursuit then flies the arc through it).
 pub(crate) fn track(g: &Grid, seed: &Seed, lookahead: f64, u: &mut [f64]) {
     let pts = seed.points();
     let arc = seed.arc_lengths();
@@ -1036,10 +1105,11 @@ pub(crate) fn track(g: &Grid, seed: &Seed, lookahead: f64, u: &mut [f64]) {
     }
     let mut s = State::initial(g);
     let step_len = g.speed * g.dt;
-    let la = lookahead * step_len;
+    let la = lookahead * g.speed;
     let mut i = 0;
     let mut gi = 0;
     let mut guide = Guide::default();
+    let mut turn = 0i8;
     let dist = |a: &[f64; 3], p: &[f64; 3]| ((a[0] - p[0]).powi(2) + (a[1] - p[1]).powi(2)).sqrt();
     // The pursuit command at `st` (advancing the progress along the seed and its gates).
     let mut command = |st: &State| -> (f64, f64) {
@@ -1056,13 +1126,17 @@ pub(crate) fn track(g: &Grid, seed: &Seed, lookahead: f64, u: &mut [f64]) {
             m += 1;
         }
         i = best;
+        // A gate is passed as the guidance passes a target (within a quarter sample, or
+        // behind and within two steps), so that near a target both aim at it.
         let (sh, ch) = st.sc_head;
         while gi < gates.len() {
             let gp = pts[gates[gi]];
             let (dx, dy) = (gp[0] - st.p[0], gp[1] - st.p[1]);
+            let d = (dx * dx + dy * dy).sqrt();
             let behind = dx * ch + dy * sh <= 0.0;
-            if i >= gates[gi] || (behind && dx.hypot(dy) < 2.0 * step_len) {
+            if d < 0.25 * g.speed * g.h || (behind && d < 2.0 * step_len) {
                 gi += 1;
+                i = i.max(gates[gi - 1]);
             } else {
                 break;
             }
@@ -1073,18 +1147,29 @@ pub(crate) fn track(g: &Grid, seed: &Seed, lookahead: f64, u: &mut [f64]) {
         } else {
             seed.point_at_arc(sq)
         };
-        pursuit(g, st, &q)
+        pursuit(g, st, &q, &mut turn)
     };
     for k in 0..g.steps {
         let j0 = k * g.sub;
         // Trial: pursuit over the step's samples; the mean offset is the coordinate.
         let (mut trial, mut tguide) = (s, guide);
         let (mut sum_r, mut sum_g) = (0.0, 0.0);
+        let mut counted = 0;
+        let mut passed = false;
         for q in 0..g.sub {
             let (rate, gamma_cmd) = command(&trial);
-            let (cr, cg) = tguide.command(g, &trial, g.time(j0 + q));
+            let gate_before = tguide.gate;
+            let (cr, cg) = tguide.command(g, &trial, j0 + q);
+            if tguide.gate != gate_before && q > 0 {
+                // The guidance passed a target: up to here both aimed at it, so the
+                // offsets so far fly through it; the rest of the step would pull the
+                // approach away.
+                passed = true;
+                break;
+            }
             sum_r += rate - cr;
             sum_g += gamma_cmd - cg;
+            counted += 1;
             if !g.spatial {
                 step_planar(g, &mut trial, rate);
             } else {
@@ -1092,28 +1177,48 @@ pub(crate) fn track(g: &Grid, seed: &Seed, lookahead: f64, u: &mut [f64]) {
                 step_spatial(g, &mut trial, ge, w);
             }
         }
-        let inv = 1.0 / g.sub as f64;
-        if std::env::var("SWARM_DEBUG_TRACK").is_ok() && k > 28 && k < 40 {
-            eprintln!("k {k} p {:?} head {:.1} sum_r {sum_r:.4} trial head {:.1}", s.p, s.head.to_degrees(), trial.head.to_degrees());
+        let inv = 1.0 / counted.max(1) as f64;
+        let (mut o_r, mut o_g) = (sum_r * inv, sum_g * inv);
+        // The guidance varies within the step, so the mean offset does not reproduce the
+        // trial: correct it (three passes) until the step ends with the trial's heading
+        // (and flight-path angle).
+        let clamp_r = |o: f64| o.clamp(g.lo[g.nu - 1], g.hi[g.nu - 1]);
+        let clamp_g = |o: f64| o.clamp(g.lo[0], g.hi[0]);
+        (o_r, o_g) = (clamp_r(o_r), clamp_g(o_g));
+        for _ in 0..if passed { 0 } else { TRACK_PASSES } {
+            let (mut probe, mut pguide) = (s, guide);
+            fly_step(g, &mut probe, &mut pguide, j0, o_r, o_g);
+            o_r = clamp_r(o_r + (trial.head - probe.head) / g.dt);
+            o_g = clamp_g(o_g + (trial.gam - probe.gam));
         }
         if !g.spatial {
-            u[k] = (sum_r * inv).clamp(g.lo[0], g.hi[0]);
+            u[k] = o_r;
         } else {
-            u[2 * k] = (sum_g * inv).clamp(g.lo[0], g.hi[0]);
-            u[2 * k + 1] = (sum_r * inv).clamp(g.lo[1], g.hi[1]);
+            u[2 * k] = o_g;
+            u[2 * k + 1] = o_r;
         }
         // The step as the particle flies it.
-        for q in 0..g.sub {
-            let (cr, cg) = guide.command(g, &s, g.time(j0 + q));
-            if !g.spatial {
-                step_planar(g, &mut s, (cr + u[k]).clamp(-g.rate_max, g.rate_max));
-            } else {
-                let (ge, w) = spatial_controls(g, &s, cg + u[2 * k], cr + u[2 * k + 1]);
-                step_spatial(g, &mut s, ge, w);
-            }
+        fly_step(g, &mut s, &mut guide, j0, o_r, o_g);
+    }
+}
+
+/// Flies the `sub` samples of a control step from sample `j0` with constant offsets
+/// (turn or heading rate `o_r`, flight-path angle `o_g`) to the guidance, as
+/// [`Flyer::step`] does.
+fn fly_step(g: &Grid, s: &mut State, guide: &mut Guide, j0: usize, o_r: f64, o_g: f64) {
+    for q in 0..g.sub {
+        let (cr, cg) = guide.command(g, s, j0 + q);
+        if !g.spatial {
+            step_planar(g, s, (cr + o_r).clamp(-g.rate_max, g.rate_max));
+        } else {
+            let (ge, w) = spatial_controls(g, s, cg + o_g, cr + o_r);
+            step_spatial(g, s, ge, w);
         }
     }
 }
+
+/// Correction passes of the seed tracker's offsets (see [`track`]).
+const TRACK_PASSES: usize = 1;
 
 /// Output buffers of [`write_trajectory`] (3-D lift input).
 #[derive(Debug, Clone, Default)]
@@ -1170,11 +1275,8 @@ pub(crate) fn write_trajectory(
     buf.clear();
     out.clear();
     let eps = 1e-6 * g.h;
-    let mut fin = rep.passes[rep.n_passes - 1];
+    let fin = rep.passes[rep.n_passes - 1];
     let segs = rep.flown;
-    if std::env::var("SWARM_DEBUG_FULL").is_ok() {
-        fin = Pass { seg: segs - 1, frac: 1.0, dist: 0.0 };
-    }
     // The state at fraction `f` of segment `j`: one partial step of the same model.
     let partial = |j: usize, f: f64| -> OutState {
         let th = f * g.h;
@@ -1250,10 +1352,19 @@ pub(crate) fn write_trajectory(
         rate,
     } = buf;
     let n = times.len();
+    // One allocation per buffer for a fresh trajectory, none for a large enough one.
+    out.times.reserve_exact(n);
+    out.states.reserve_exact(n);
+    out.controls.reserve_exact(n);
+    out.phase_ends.reserve_exact(rep.n_passes);
     if !g.spatial {
         for i in 0..n {
             let p = pos[i];
-            out.push(times[i], [p[0], p[1], chi[i], 0.0, 0.0, 0.0, 0.0], [rate[i], 0.0]);
+            out.push(
+                times[i],
+                [p[0], p[1], chi[i], 0.0, 0.0, 0.0, 0.0],
+                [rate[i], 0.0],
+            );
         }
     } else {
         let model = Spatial::new(g.speed)?;
@@ -1290,4 +1401,27 @@ pub(crate) fn write_trajectory(
     }
     out.phase_ends.push(t_last);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The fast trigonometry against libm: `sin_cos_small` within 1e-10 on `[-1, 1]`
+    /// (series below 0.6, libm above), `atan_fast` within 1e-5 rad on `[-1e3, 1e3]`.
+    #[test]
+    fn fast_trigonometry_is_accurate() {
+        for k in -1000..=1000 {
+            let x = k as f64 * 1e-3;
+            let (s, c) = sin_cos_small(x);
+            assert!(
+                (s - x.sin()).abs() < 1e-10 && (c - x.cos()).abs() < 1e-10,
+                "{x}"
+            );
+        }
+        for k in -20000..=20000 {
+            let z = (k as f64 * 5e-4).powi(3);
+            assert!((atan_fast(z) - z.atan()).abs() < 1e-5, "{z}");
+        }
+    }
 }

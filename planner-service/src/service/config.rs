@@ -1,0 +1,275 @@
+//! The service's settings (`planner.toml`). Every setting has a default, so an empty file
+//! (or no file) is a valid configuration; unknown keys are refused so a typo cannot
+//! silently drop a setting. `planner.toml` at the repository root documents every key and
+//! holds exactly these defaults (a test keeps them equal).
+
+use std::path::Path;
+use std::time::Duration;
+
+use serde::{Deserialize, Serialize};
+use wingman_interfaces::{Model, validate_vehicle_id};
+
+/// A configuration that cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("{file}: cannot be read: {source}")]
+    Read {
+        file: String,
+        source: std::io::Error,
+    },
+    #[error("{file}: {message}")]
+    Parse { file: String, message: String },
+    #[error("key `{key}`: {problem}")]
+    Invalid { key: &'static str, problem: String },
+}
+
+/// Everything `wingman-planner serve` can be told.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ServiceConfig {
+    /// Vehicle id: every service name starts with `wingman/<vehicle_id>/`.
+    pub vehicle_id: String,
+    pub budget: BudgetConfig,
+    pub triggers: TriggerConfig,
+    pub staleness: StalenessConfig,
+    pub status: StatusConfig,
+    pub solver: SolverConfig,
+}
+
+/// Compute budget of one plan, and the limits that keep bursts of triggers from starving
+/// the flight computer.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BudgetConfig {
+    /// Deadline of a 2-D plan, ms. The plan commits this long after its trigger.
+    pub plan_2d_ms: u64,
+    /// Deadline of a 3-D plan, ms.
+    pub plan_3d_ms: u64,
+    /// Least wall-clock time between the starts of two plans, ms.
+    pub min_spacing_ms: u64,
+    /// Share of one core the planner may spend planning over the sliding window (0–1].
+    pub duty_cycle: f64,
+    /// Length of the duty-cycle window, ms.
+    pub duty_window_ms: u64,
+}
+
+/// When to re-plan (FORMULATION.md §6).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TriggerConfig {
+    /// A pop-up re-plans when `F < f_star` at a remaining sample of the plan.
+    pub f_star: f64,
+    /// A cross-track deviation (from `OwnshipState`) beyond this re-plans, m.
+    pub deviation_cross_m: f64,
+    /// A vertical deviation beyond this re-plans (3-D), m.
+    pub deviation_vertical_m: f64,
+    /// A scheduled re-plan time `t_r` is looked for only this long after a plan's start,
+    /// s: a plan just made from the newest estimate is not re-made at once.
+    pub replan_min_lead_s: f64,
+}
+
+/// Inputs that stop arriving are reported in `PlannerStatus::stale_inputs` (wall clock).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StalenessConfig {
+    /// Lead state (rendezvous missions only), ms.
+    pub lead_ms: u64,
+    /// Ownship state, ms.
+    pub ownship_ms: u64,
+    /// Track fixes of a known moving threat, ms.
+    pub tracks_ms: u64,
+}
+
+/// The heartbeat.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StatusConfig {
+    /// `PlannerStatus` is published at least this often, ms.
+    pub heartbeat_ms: u64,
+}
+
+/// The hybrid planner on the solve thread.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SolverConfig {
+    /// Seed of the particle swarm (same inputs and seed: same plan).
+    pub seed: u64,
+    /// Worker threads of the particle swarm (the NLP runs on the solve thread alone).
+    pub swarm_threads: usize,
+}
+
+impl Default for ServiceConfig {
+    fn default() -> Self {
+        ServiceConfig {
+            vehicle_id: "w1".into(),
+            budget: BudgetConfig::default(),
+            triggers: TriggerConfig::default(),
+            staleness: StalenessConfig::default(),
+            status: StatusConfig::default(),
+            solver: SolverConfig::default(),
+        }
+    }
+}
+
+impl Default for BudgetConfig {
+    fn default() -> Self {
+        BudgetConfig {
+            plan_2d_ms: 150,
+            plan_3d_ms: 600,
+            min_spacing_ms: 250,
+            duty_cycle: 0.5,
+            duty_window_ms: 10_000,
+        }
+    }
+}
+
+impl Default for TriggerConfig {
+    fn default() -> Self {
+        TriggerConfig {
+            f_star: 1.0,
+            deviation_cross_m: 500.0,
+            deviation_vertical_m: 200.0,
+            replan_min_lead_s: 1.0,
+        }
+    }
+}
+
+impl Default for StalenessConfig {
+    fn default() -> Self {
+        StalenessConfig {
+            lead_ms: 2000,
+            ownship_ms: 1000,
+            tracks_ms: 5000,
+        }
+    }
+}
+
+impl Default for StatusConfig {
+    fn default() -> Self {
+        StatusConfig { heartbeat_ms: 1000 }
+    }
+}
+
+impl Default for SolverConfig {
+    fn default() -> Self {
+        SolverConfig {
+            seed: 1,
+            swarm_threads: 2,
+        }
+    }
+}
+
+/// Most plan intervals the duty-cycle window keeps (see `budget::ComputeGate`).
+pub const DUTY_HISTORY: usize = 256;
+
+impl ServiceConfig {
+    /// Parses TOML text; `file` names it in errors. The result is validated.
+    pub fn from_toml(text: &str, file: &str) -> Result<ServiceConfig, ConfigError> {
+        let cfg: ServiceConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {
+            file: file.to_string(),
+            message: e.to_string().trim_end().replace('\n', " "),
+        })?;
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    /// Reads and validates a configuration file.
+    pub fn load(path: impl AsRef<Path>) -> Result<ServiceConfig, ConfigError> {
+        let path = path.as_ref();
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+            file: file.clone(),
+            source,
+        })?;
+        Self::from_toml(&text, &file)
+    }
+
+    /// The configuration as TOML (what `serve --print-config` shows).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).unwrap_or_default()
+    }
+
+    /// Checks ranges and consistency.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let bad = |key: &'static str, problem: String| Err(ConfigError::Invalid { key, problem });
+        if let Err(e) = validate_vehicle_id(&self.vehicle_id) {
+            return bad("vehicle_id", e.to_string());
+        }
+        let b = &self.budget;
+        if b.plan_2d_ms == 0 || b.plan_3d_ms == 0 {
+            return bad("budget.plan_2d_ms", "plan budgets must be positive".into());
+        }
+        if !(b.duty_cycle > 0.0 && b.duty_cycle <= 1.0) {
+            return bad(
+                "budget.duty_cycle",
+                format!("must be in (0, 1], got {}", b.duty_cycle),
+            );
+        }
+        if b.duty_window_ms == 0 {
+            return bad("budget.duty_window_ms", "must be positive".into());
+        }
+        let cap_ms = b.duty_cycle * b.duty_window_ms as f64;
+        let largest = b.plan_2d_ms.max(b.plan_3d_ms) as f64;
+        if cap_ms < largest {
+            return bad(
+                "budget.duty_cycle",
+                format!(
+                    "duty_cycle x duty_window_ms = {cap_ms} ms is less than one plan's budget \
+                     ({largest} ms): no plan could ever start"
+                ),
+            );
+        }
+        let spacing = b.min_spacing_ms.max(1);
+        if b.duty_window_ms / spacing > DUTY_HISTORY as u64 {
+            return bad(
+                "budget.min_spacing_ms",
+                format!(
+                    "duty_window_ms / min_spacing_ms must be at most {DUTY_HISTORY} (plans the \
+                     window can hold)"
+                ),
+            );
+        }
+        let t = &self.triggers;
+        if !(t.f_star.is_finite() && t.f_star > 0.0) {
+            return bad(
+                "triggers.f_star",
+                format!("must be positive, got {}", t.f_star),
+            );
+        }
+        for (key, v) in [
+            ("triggers.deviation_cross_m", t.deviation_cross_m),
+            ("triggers.deviation_vertical_m", t.deviation_vertical_m),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return bad(key, format!("must be positive, got {v}"));
+            }
+        }
+        if !(t.replan_min_lead_s.is_finite() && t.replan_min_lead_s >= 0.0) {
+            return bad("triggers.replan_min_lead_s", "must not be negative".into());
+        }
+        if self.status.heartbeat_ms == 0 {
+            return bad("status.heartbeat_ms", "must be positive".into());
+        }
+        let s = &self.staleness;
+        if s.lead_ms == 0 || s.ownship_ms == 0 || s.tracks_ms == 0 {
+            return bad("staleness", "bounds must be positive".into());
+        }
+        if self.solver.swarm_threads == 0 {
+            return bad("solver.swarm_threads", "must be at least 1".into());
+        }
+        Ok(())
+    }
+
+    /// Compute budget of one plan of `model`.
+    pub fn plan_budget(&self, model: Model) -> Duration {
+        Duration::from_millis(match model {
+            Model::TwoD => self.budget.plan_2d_ms,
+            Model::ThreeD => self.budget.plan_3d_ms,
+        })
+    }
+
+    /// Heartbeat period.
+    pub fn heartbeat(&self) -> Duration {
+        Duration::from_millis(self.status.heartbeat_ms)
+    }
+}

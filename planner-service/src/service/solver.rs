@@ -1,0 +1,259 @@
+//! The solve thread: it owns the hybrid [`Planner`] (its workspaces are reused plan after
+//! plan), takes one request at a time over a crossbeam channel — a problem snapshot with
+//! its ticket (plan id, trigger, commit time, budget) — plans it under a deadline of the
+//! budget, sends the outcome back with the problem (whose buffers the message thread
+//! reuses) and wakes the message thread.
+//!
+//! At most one request is in flight: the request channel holds one, and the message thread
+//! sends the next only after it took the previous result. A panic inside the planner is
+//! caught, reported as [`SolveError::Panicked`], and the planner rebuilt.
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use crossbeam::channel::{self, Receiver, Sender};
+use tracing::{error, info, info_span};
+use wingman_interfaces::Trigger;
+
+use crate::clock::{Clock, Deadline};
+use crate::hybrid::{PlanError, PlanOutcome, Planner, PlannerSettings};
+use crate::problem::Problem;
+
+/// What travels with a problem to the solver and back.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ticket {
+    pub plan_id: u64,
+    pub trigger: Trigger,
+    /// Mission time of the trigger.
+    pub created_at_s: f64,
+    /// Compute budget (the deadline).
+    pub budget: Duration,
+    /// World epoch of the snapshot (threats changed after it are not in the plan).
+    pub epoch: u64,
+    /// Targets of the tasking left out as passed.
+    pub targets_from: usize,
+    /// Revision of the tasking the problem was built from.
+    pub tasking_revision: u32,
+}
+
+/// A plan to make.
+#[derive(Debug)]
+pub struct SolveRequest {
+    pub problem: Box<Problem>,
+    pub ticket: Ticket,
+}
+
+/// Why the solver returned no plan.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SolveError {
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+    #[error("the planner panicked; it was rebuilt")]
+    Panicked,
+}
+
+/// A plan made (or not).
+#[derive(Debug)]
+pub struct SolveResult {
+    pub problem: Box<Problem>,
+    pub ticket: Ticket,
+    pub outcome: Result<PlanOutcome, SolveError>,
+    /// Start and end on the injected clock.
+    pub started: Duration,
+    pub finished: Duration,
+    /// Core time used (the swarm stage counted once per worker thread).
+    pub core_time: Duration,
+}
+
+/// Builds, on the solve thread, the function that wakes the message thread after each
+/// result (an iceoryx2 notifier is not `Send`, so it is made where it is used).
+pub type WakerFactory = Box<dyn FnOnce() -> Result<Box<dyn FnMut()>, String> + Send>;
+
+/// The solve thread could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum SolverStartError {
+    #[error("cannot spawn the solve thread: {0}")]
+    Spawn(#[from] std::io::Error),
+    #[error("the solve thread cannot wake the message thread: {0}")]
+    Waker(String),
+}
+
+/// Handle of the solve thread.
+pub struct Solver {
+    requests: Option<Sender<SolveRequest>>,
+    results: Receiver<SolveResult>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl Solver {
+    /// Starts the solve thread with its planner.
+    pub fn spawn(
+        settings: PlannerSettings,
+        clock: &'static dyn Clock,
+        waker: WakerFactory,
+    ) -> Result<Solver, SolverStartError> {
+        let (req_tx, req_rx) = channel::bounded::<SolveRequest>(1);
+        let (res_tx, res_rx) = channel::bounded::<SolveResult>(1);
+        let (ready_tx, ready_rx) = channel::bounded::<Result<(), String>>(1);
+        let thread = std::thread::Builder::new()
+            .name("wingman-solve".into())
+            .spawn(move || {
+                let mut wake = match waker() {
+                    Ok(w) => {
+                        let _ = ready_tx.send(Ok(()));
+                        w
+                    }
+                    Err(e) => {
+                        let _ = ready_tx.send(Err(e));
+                        return;
+                    }
+                };
+                solve_loop(&settings, clock, &req_rx, &res_tx, &mut *wake);
+            })?;
+        match ready_rx.recv() {
+            Ok(Ok(())) => Ok(Solver {
+                requests: Some(req_tx),
+                results: res_rx,
+                thread: Some(thread),
+            }),
+            Ok(Err(e)) => {
+                let _ = thread.join();
+                Err(SolverStartError::Waker(e))
+            }
+            Err(_) => {
+                let _ = thread.join();
+                Err(SolverStartError::Waker("the solve thread ended".into()))
+            }
+        }
+    }
+
+    /// Hands a request to the solve thread; gives it back if one is already queued or the
+    /// thread is gone.
+    pub fn submit(&self, request: SolveRequest) -> Result<(), SolveRequest> {
+        match &self.requests {
+            Some(tx) => tx.try_send(request).map_err(|e| e.into_inner()),
+            None => Err(request),
+        }
+    }
+
+    /// A finished plan, if one is waiting.
+    pub fn try_result(&self) -> Option<SolveResult> {
+        self.results.try_recv().ok()
+    }
+
+    /// Waits up to `timeout` for a finished plan.
+    pub fn wait_result(&self, timeout: Duration) -> Option<SolveResult> {
+        self.results.recv_timeout(timeout).ok()
+    }
+
+    /// Whether the solve thread is still running.
+    pub fn is_alive(&self) -> bool {
+        self.thread.as_ref().is_some_and(|t| !t.is_finished())
+    }
+
+    /// Stops taking requests and joins the thread once it has finished the plan in hand
+    /// (waiting at most `timeout`; past it the thread is left to end with the process).
+    pub fn shutdown(mut self, timeout: Duration) {
+        self.requests = None;
+        let Some(thread) = self.thread.take() else {
+            return;
+        };
+        let step = Duration::from_millis(5);
+        let mut waited = Duration::ZERO;
+        while !thread.is_finished() && waited < timeout {
+            // Drain results so the thread is never blocked sending one.
+            let _ = self.results.recv_timeout(step);
+            waited += step;
+        }
+        if thread.is_finished() {
+            let _ = thread.join();
+        } else {
+            error!(
+                "the solve thread did not end within {timeout:?}; leaving it to the process exit"
+            );
+        }
+    }
+}
+
+impl Drop for Solver {
+    fn drop(&mut self) {
+        self.requests = None;
+        if let Some(thread) = self.thread.take() {
+            // Unblock a pending send, then join: the plan in hand ends by its deadline.
+            while !thread.is_finished() {
+                let _ = self.results.recv_timeout(Duration::from_millis(5));
+            }
+            let _ = thread.join();
+        }
+    }
+}
+
+fn solve_loop(
+    settings: &PlannerSettings,
+    clock: &'static dyn Clock,
+    requests: &Receiver<SolveRequest>,
+    results: &Sender<SolveResult>,
+    wake: &mut dyn FnMut(),
+) {
+    let mut planner = Planner::new(settings);
+    let threads = settings.swarm.threads.max(1) as u32;
+    for request in requests.iter() {
+        let SolveRequest { problem, ticket } = request;
+        let span = info_span!(
+            "plan",
+            id = ticket.plan_id,
+            trigger = ticket.trigger.name(),
+            budget_ms = ticket.budget.as_millis() as u64,
+            t0 = problem.t0,
+        );
+        let _entered = span.enter();
+        let started = clock.now();
+        let deadline = Deadline::after(clock, ticket.budget);
+        let outcome = match catch_unwind(AssertUnwindSafe(|| {
+            planner.plan(&problem, settings, deadline)
+        })) {
+            Ok(r) => r.map_err(SolveError::from),
+            Err(_) => {
+                planner = Planner::new(settings);
+                Err(SolveError::Panicked)
+            }
+        };
+        let finished = clock.now();
+        let wall = finished.saturating_sub(started);
+        let core_time = match &outcome {
+            Ok(o) => wall + o.times.swarm.min(wall) * (threads - 1),
+            Err(_) => wall,
+        };
+        match &outcome {
+            Ok(o) => info!(
+                quality = o.quality.name(),
+                cost = o.cost,
+                swarm_ms = ms(o.times.swarm),
+                nlp_ms = ms(o.times.nlp),
+                export_ms = ms(o.times.export),
+                total_ms = ms(o.times.total),
+                samples = o.trajectory.len(),
+                "plan made"
+            ),
+            Err(e) => error!(error = %e, "no plan"),
+        }
+        drop(_entered);
+        let result = SolveResult {
+            problem,
+            ticket,
+            outcome,
+            started,
+            finished,
+            core_time,
+        };
+        if results.send(result).is_err() {
+            return;
+        }
+        wake();
+    }
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}

@@ -1,0 +1,256 @@
+//! When to re-plan (FORMULATION.md §6, issue 6 item 2): each trigger as a pure function of
+//! the world and the current plan, with no clock, no allocation and no I/O, so each can be
+//! tested on the case that fires it and on the near miss beside it.
+//!
+//! The triggers are, and nothing else (no periodic re-planning):
+//! - the first tasking ([`Trigger::Initial`], or [`Trigger::Restart`] when the mission is
+//!   already under way: a restarted planner);
+//! - a pop-up whose region reaches the remaining plan, `F < F*` ([`static_popup`],
+//!   [`moving_popup`]; a moving threat at its region propagated to each sample's time);
+//! - a tasking change: a larger revision with other targets, final point, objective,
+//!   model, limits or weights ([`tasking_decision`]);
+//! - a lead route change: a larger revision with another route ([`route_decision`]);
+//! - the scheduled `t_r` of a moving threat that touches the plan (eqs. 7.1–7.6,
+//!   [`scheduled_replan`]), acted on one plan budget early so the new plan commits at
+//!   `t_r` ([`scheduled_due`]);
+//! - the tracker's deviation from the plan beyond a bound ([`deviation_exceeded`]);
+//! - the plan expiring with no successor, or the tracker flying a safe hold
+//!   ([`expiry_due`]).
+
+use wingman_interfaces::{LeadRoute, OwnshipState, Tasking, Trigger};
+
+use crate::estimation::MovingThreat;
+use crate::replan::{self, PlanPoint, PopupHit, ReplanTime};
+use crate::threat::Superquadric;
+
+/// What a received tasking means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TaskingDecision {
+    /// The first tasking: plan the mission.
+    First,
+    /// A larger revision with different content: re-plan.
+    Changed,
+    /// A larger revision with the same content: keep it, no plan.
+    Unchanged,
+    /// Not a larger revision (a repeat or an old one): ignore.
+    Stale,
+}
+
+/// Compares a received tasking with the one held.
+pub fn tasking_decision(held: Option<&Tasking>, received: &Tasking) -> TaskingDecision {
+    let Some(held) = held else {
+        return TaskingDecision::First;
+    };
+    if received.revision <= held.revision {
+        return TaskingDecision::Stale;
+    }
+    let same = held.model == received.model
+        && held.objective == received.objective
+        && held.limits == received.limits
+        && held.weights == received.weights
+        && held.targets() == received.targets()
+        && held.final_state == received.final_state
+        && held.final_time_s == received.final_time_s;
+    if same {
+        TaskingDecision::Unchanged
+    } else {
+        TaskingDecision::Changed
+    }
+}
+
+/// What a received lead route means.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RouteDecision {
+    First,
+    Changed,
+    Unchanged,
+    Stale,
+}
+
+/// Compares a received lead route with the one held.
+pub fn route_decision(held: Option<&LeadRoute>, received: &LeadRoute) -> RouteDecision {
+    let Some(held) = held else {
+        return RouteDecision::First;
+    };
+    if received.revision <= held.revision {
+        return RouteDecision::Stale;
+    }
+    let same = held.points() == received.points()
+        && held.speed_mps == received.speed_mps
+        && held.start_time_s == received.start_time_s;
+    if same {
+        RouteDecision::Unchanged
+    } else {
+        RouteDecision::Changed
+    }
+}
+
+/// A pop-up assessed against the remaining plan.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PopupAssessment {
+    /// `F < F*` at this sample: re-plan.
+    Touches(PopupHit),
+    /// Clear of the plan: logged, counted, no plan.
+    Clear,
+}
+
+impl PopupAssessment {
+    pub fn touches(&self) -> bool {
+        matches!(self, PopupAssessment::Touches(_))
+    }
+}
+
+/// The samples of `plan` at or after `now`.
+pub fn remaining<const D: usize>(plan: &[PlanPoint<D>], now: f64) -> &[PlanPoint<D>] {
+    let k = plan.partition_point(|p| p.t < now);
+    &plan[k..]
+}
+
+/// Pop-up test of a static threat against the remaining plan.
+pub fn static_popup<const D: usize>(
+    remaining: &[PlanPoint<D>],
+    threat: &Superquadric<D>,
+    f_star: f64,
+) -> PopupAssessment {
+    match replan::static_popup_hit(remaining, threat, f_star) {
+        Some(hit) => PopupAssessment::Touches(hit),
+        None => PopupAssessment::Clear,
+    }
+}
+
+/// Pop-up test of a moving threat against the remaining plan, its region propagated to
+/// each sample's time.
+pub fn moving_popup<const D: usize>(
+    remaining: &[PlanPoint<D>],
+    threat: &MovingThreat<D>,
+    f_star: f64,
+) -> PopupAssessment {
+    match replan::moving_popup_hit(remaining, threat, f_star) {
+        Some(hit) => PopupAssessment::Touches(hit),
+        None => PopupAssessment::Clear,
+    }
+}
+
+/// `t_r` (eqs. 7.1–7.6) of a moving threat over a plan, looked for from `not_before` on
+/// (the plan's start plus `replan_min_lead_s`). `None`: the threat never comes within the
+/// critical distance of the plan.
+pub fn scheduled_replan<const D: usize>(
+    plan: &[PlanPoint<D>],
+    threat: &MovingThreat<D>,
+    not_before: f64,
+) -> Option<ReplanTime> {
+    replan::replan_time(remaining(plan, not_before), threat)
+}
+
+/// Whether the scheduled re-plan is due at mission time `now`: one plan budget (`lead_s`)
+/// before `t_r`, so that the new plan commits at `t_r`. (Mission time travels in whole
+/// nanoseconds: a microsecond of tolerance absorbs the rounding.)
+pub fn scheduled_due(now: f64, t_r: f64, lead_s: f64) -> bool {
+    now >= t_r - lead_s - TIME_TOLERANCE_S
+}
+
+/// Tolerance of mission-time comparisons, s.
+pub const TIME_TOLERANCE_S: f64 = 1e-6;
+
+/// Bounds of the tracker's deviation from the plan.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DeviationBounds {
+    pub cross_m: f64,
+    pub vertical_m: f64,
+}
+
+/// Whether the ownship, flying the plan `current_plan_id`, deviates from it beyond the
+/// bounds. A report about another plan (the tracker has not switched yet) or from a safe
+/// hold does not count: the hold is [`expiry_due`]'s case.
+pub fn deviation_exceeded(
+    ownship: &OwnshipState,
+    current_plan_id: u64,
+    bounds: &DeviationBounds,
+) -> bool {
+    current_plan_id != 0
+        && ownship.plan_id == current_plan_id
+        && !ownship.holding()
+        && (ownship.cross_track_m.abs() > bounds.cross_m
+            || ownship.vertical_m.abs() > bounds.vertical_m)
+}
+
+/// The current plan's time window.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanWindow {
+    pub start_s: f64,
+    pub valid_until_s: f64,
+    pub final_time_s: f64,
+}
+
+impl PlanWindow {
+    /// Whether the plan may be flown to its end (not cut short by a scheduled re-plan).
+    pub fn reaches_end(&self) -> bool {
+        self.valid_until_s >= self.final_time_s
+    }
+}
+
+/// Whether the plan expires with no successor: at mission time `now` it is within one
+/// plan budget (`lead_s`) of `valid_until` while cut short of its end, or the tracker
+/// reports flying a safe hold. A plan that runs to its end (the mission's end) does not
+/// expire: the mission is over.
+pub fn expiry_due(now: f64, plan: &PlanWindow, lead_s: f64, holding: bool) -> bool {
+    if holding {
+        return now < plan.final_time_s || !plan.reaches_end();
+    }
+    !plan.reaches_end() && now >= plan.valid_until_s - lead_s - TIME_TOLERANCE_S
+}
+
+/// Whether the first plan of a tasking is a restart: the tracker already flies a plan
+/// (of a predecessor process), or the ownship's clock is past the tasking's start.
+pub fn first_plan_trigger(tasking: &Tasking, ownship: Option<&OwnshipState>) -> Trigger {
+    match ownship {
+        Some(o) if o.plan_id != 0 || o.time_s > tasking.start_time_s => Trigger::Restart,
+        _ => Trigger::Initial,
+    }
+}
+
+/// A set of pending triggers (a bit per [`Trigger`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct TriggerSet(u32);
+
+/// Triggers in the order the plan message names them when several are pending.
+const PRIORITY: [Trigger; 8] = [
+    Trigger::Initial,
+    Trigger::Restart,
+    Trigger::Tasking,
+    Trigger::LeadRoute,
+    Trigger::PopUp,
+    Trigger::Deviation,
+    Trigger::ScheduledReplan,
+    Trigger::Expiry,
+];
+
+impl TriggerSet {
+    pub const EMPTY: TriggerSet = TriggerSet(0);
+
+    pub fn insert(&mut self, t: Trigger) {
+        self.0 |= 1 << t.to_wire();
+    }
+
+    pub fn contains(&self, t: Trigger) -> bool {
+        self.0 & (1 << t.to_wire()) != 0
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.0 == 0
+    }
+
+    pub fn union(self, other: TriggerSet) -> TriggerSet {
+        TriggerSet(self.0 | other.0)
+    }
+
+    /// Whether every pending trigger is a pop-up (which a newer plan may already avoid).
+    pub fn only_popups(&self) -> bool {
+        self.0 == 1 << Trigger::PopUp.to_wire()
+    }
+
+    /// The trigger a plan made for this set is named after.
+    pub fn primary(&self) -> Option<Trigger> {
+        PRIORITY.into_iter().find(|t| self.contains(*t))
+    }
+}

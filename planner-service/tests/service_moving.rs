@@ -1,0 +1,144 @@
+//! A 3-D mission with a threat moving on a road (`3d-min-time-moving-threat`) through the
+//! in-process service: the first plan is made from the threat's reported estimate; every
+//! track fix goes to its Kalman filter; when the plan carries a scheduled re-plan time
+//! `t_r`, a mission clock reaching `t_r - budget` makes a `ScheduledReplan` plan that
+//! commits at `t_r`.
+
+mod service_support;
+
+use std::time::Duration;
+
+use service_support::*;
+use wingman_interfaces::*;
+use wingman_planner::scenario::bundled;
+
+#[test]
+fn a_moving_threat_is_tracked_and_its_t_r_schedules_a_replan() {
+    let v = vehicle("moving");
+    let mut cfg = test_config(&v);
+    // A re-plan commits `budget` after its trigger; with a budget longer than the gap
+    // to the next t_r every plan would be due at once. (A debug build may return a
+    // swarm-only plan within it: the quality is not checked here.)
+    cfg.budget.plan_3d_ms = 5000;
+    let budget_s = cfg.budget.plan_3d_ms as f64 * 1e-3;
+    let service = ServiceThread::start(cfg);
+    let mut h = FakeHarness::new(&v);
+    assert!(h.wait_until(Duration::from_secs(20), |h| h.status.is_some()));
+    let sc = bundled("3d-min-time-moving-threat").unwrap().unwrap();
+    let m = &sc.moving_threats[0];
+    let mut report = ThreatReport::zeroed();
+    report.threat_id = 40;
+    report.kind = ThreatKind::Moving.to_wire();
+    report.axes_m = m.axes_m;
+    report.road_point_count = m.road_m.len() as u32;
+    for (k, p) in m.road_m.iter().enumerate() {
+        report.road_m[k] = *p;
+    }
+    report.estimate_time_s = 0.0;
+    report.estimate_mean = [m.initial_distance_m, m.initial_speed_mps, 0.0];
+    let s = m.initial_sigma;
+    report.estimate_covariance = [
+        s[0] * s[0],
+        0.0,
+        0.0,
+        0.0,
+        s[1] * s[1],
+        0.0,
+        0.0,
+        0.0,
+        s[2] * s[2],
+    ];
+    report.accel_sigma_mps2 = m.accel_sigma_mps2;
+    report.accel_tau_s = m.accel_tau_s;
+    for t in scenario_threats(&sc) {
+        h.send_threat(t);
+    }
+    h.send_threat(report);
+    h.send_tasking(tasking_from(&sc, 1));
+    h.wake();
+    assert!(
+        h.wait_until(Duration::from_secs(180), |h| !h.plans.is_empty()
+            && h.status
+                .is_some_and(|s| s.state() != Some(PlannerState::Planning))),
+        "no first plan: {:?}",
+        h.status
+    );
+    let first = h.plans[0].clone();
+    assert_eq!(first.model(), Some(Model::ThreeD));
+    assert_eq!(first.trigger(), Some(Trigger::Initial));
+    eprintln!(
+        "first plan: quality {:?}, final {:.1} s, valid until {:.1} s, t_r {:?}",
+        first.quality(),
+        first.final_time_s,
+        first.valid_until_s,
+        first.next_replan()
+    );
+
+    // Track fixes at 1 Hz along the road, on the estimate's mean motion.
+    let dir = {
+        let (a, b) = (m.road_m[0], m.road_m[1]);
+        let l = (b[0] - a[0]).hypot(b[1] - a[1]);
+        [(b[0] - a[0]) / l, (b[1] - a[1]) / l]
+    };
+    for k in 1..=10 {
+        let t = k as f64;
+        h.set_time(t);
+        let d = m.initial_distance_m + m.initial_speed_mps * t;
+        let mut fix = TrackFix::zeroed();
+        fix.threat_id = 40;
+        fix.time_s = t;
+        fix.position_m = [
+            m.road_m[0][0] + d * dir[0],
+            m.road_m[0][1] + d * dir[1],
+            0.0,
+        ];
+        fix.sigma_m = m.sensor.sigma_m;
+        h.send_fix(fix);
+        h.wake();
+    }
+    assert!(h.wait_processed(Duration::from_secs(60)));
+    let s = h.last_status();
+    assert_eq!(s.messages_rejected, 0);
+    assert_eq!(
+        s.stale_inputs & STALE_TRACKS,
+        0,
+        "the fixes keep the track fresh"
+    );
+    assert_eq!(s.plans_made, 1, "fixes alone do not re-plan");
+
+    let Some(t_r) = first.next_replan() else {
+        eprintln!("the first plan keeps clear of the moving threat: no t_r to act on");
+        service.stop(&h);
+        return;
+    };
+    assert_eq!(first.valid_until_s, t_r.min(first.final_time_s));
+    // The mission clock reaches t_r - budget (an ownship state carries it): the
+    // scheduled re-plan commits near t_r (the fixes may have moved t_r a little).
+    h.set_time(t_r - budget_s);
+    let mut own = OwnshipState::zeroed();
+    own.time_s = t_r - budget_s;
+    own.model = Model::ThreeD.to_wire();
+    own.plan_id = first.plan_id;
+    own.state = wingman_planner::service::export::state_at(&first, t_r - budget_s).unwrap();
+    h.send_ownship(own);
+    h.wake();
+    assert!(
+        h.wait_until(Duration::from_secs(180), |h| h
+            .status
+            .is_some_and(
+                |s| s.plans_made >= 2 && s.state() != Some(PlannerState::Planning)
+            )),
+        "no scheduled re-plan: {:?}",
+        h.status
+    );
+    let second = &h.plans[1];
+    assert_eq!(second.trigger(), Some(Trigger::ScheduledReplan));
+    assert!(second.start_time_s >= t_r - budget_s);
+    eprintln!(
+        "scheduled re-plan: quality {:?}, start {:.1} s (t_r {t_r:.1} s), t_r now {:?}",
+        second.quality(),
+        second.start_time_s,
+        second.next_replan()
+    );
+    service.stop(&h);
+}

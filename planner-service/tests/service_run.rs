@@ -1,0 +1,197 @@
+//! The planner service driven in-process over real iceoryx2 services by a small fake
+//! harness (`service_support`), each test on its own vehicle id:
+//!
+//! - a tasking gives a plan of quality `Optimal` or `Feasible`, starting at the tasking's
+//!   start; an invalid message is rejected and counted and changes nothing; a pop-up clear
+//!   of the plan is counted and causes no plan;
+//! - a burst of 50 pop-ups that each touch the plan, within one second of mission time,
+//!   gives at most 3 plans, and the coalesced counter accounts for the rest.
+
+mod service_support;
+
+use std::time::Duration;
+
+use service_support::*;
+use wingman_interfaces::*;
+use wingman_planner::scenario::bundled;
+use wingman_planner::service::ExitReason;
+use wingman_planner::service::export::state_at;
+
+const PLAN_WAIT: Duration = Duration::from_secs(120);
+
+/// Starts a service, sends the threats and tasking of `2d-min-time-avoidable` at mission
+/// time 0 and waits for the first plan.
+fn first_plan(tag: &str) -> (ServiceThread, FakeHarness) {
+    let v = vehicle(tag);
+    let service = ServiceThread::start(test_config(&v));
+    let mut h = FakeHarness::new(&v);
+    assert!(
+        h.wait_until(Duration::from_secs(20), |h| h.status.is_some()),
+        "no heartbeat from the service"
+    );
+    let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();
+    h.set_time(0.0);
+    for t in scenario_threats(&sc) {
+        h.send_threat(t);
+    }
+    h.send_tasking(tasking_from(&sc, 1));
+    h.wake();
+    assert!(
+        h.wait_until(PLAN_WAIT, |h| !h.plans.is_empty()
+            && h.status.is_some_and(
+                |s| s.plans_made == 1 && s.state() != Some(PlannerState::Planning)
+            )),
+        "no first plan; status {:?}",
+        h.status
+    );
+    (service, h)
+}
+
+#[test]
+fn a_tasking_gives_a_plan_and_bad_or_clear_inputs_change_nothing() {
+    let (service, mut h) = first_plan("plan");
+    let plan = &h.plans[0];
+    assert!(
+        matches!(plan.quality(), Some(Quality::Optimal | Quality::Feasible)),
+        "quality {:?}",
+        plan.quality()
+    );
+    assert_eq!(plan.trigger(), Some(Trigger::Initial));
+    assert_eq!(plan.plan_id, 1);
+    assert_eq!(
+        plan.start_time_s, 0.0,
+        "the first plan starts at the tasking's start"
+    );
+    assert_eq!(plan.phase_count, 2, "one target, then the final point");
+    assert!(plan.sample_count >= 2 && plan.sample_count as usize <= MAX_PLAN_SAMPLES);
+    let first = plan.samples()[0];
+    let start = [0.0, 0.0, std::f64::consts::FRAC_PI_2];
+    assert!(
+        first.state[..3]
+            .iter()
+            .zip(start)
+            .all(|(a, b)| (a - b).abs() < 1e-6),
+        "starts at the tasking's start state: {:?}",
+        &first.state[..3]
+    );
+    let last = plan.samples()[plan.sample_count as usize - 1];
+    assert!(
+        (last.state[0] - 80000.0).hypot(last.state[1] - 10000.0) < 100.0,
+        "ends at the final point: {:?}",
+        &last.state[..2]
+    );
+    assert_eq!(plan.phase_ends()[1], plan.final_time_s);
+    assert!(plan.next_replan().is_none(), "no moving threat, no t_r");
+    let s = h.last_status();
+    assert_eq!(s.current_plan_id, 1);
+    assert_eq!(s.last_input_sequence, h.sequence);
+    assert_eq!(s.messages_rejected, 0);
+    assert!(s.last_plan_compute_ms > 0.0);
+
+    // An invalid threat report (NaN centre) and a message of another protocol version.
+    h.set_time(5.0);
+    let mut bad = static_threat(50, [10000.0, 10000.0, 0.0], [1000.0, 1000.0, 0.0]);
+    bad.header = h.header();
+    bad.center_m[0] = f64::NAN;
+    h.send_threat_raw(bad);
+    let mut foreign = static_threat(51, [10000.0, 10000.0, 0.0], [1000.0, 1000.0, 0.0]);
+    foreign.header = h.header();
+    foreign.header.protocol_version = PROTOCOL_VERSION + 1;
+    h.send_threat_raw(foreign);
+    h.wake();
+    assert!(
+        h.wait_until(Duration::from_secs(20), |h| h
+            .status
+            .is_some_and(|s| s.messages_rejected == 2)),
+        "rejections not counted: {:?}",
+        h.status
+    );
+    // A pop-up far from the plan: assessed, counted, no plan.
+    h.send_threat(static_threat(
+        60,
+        [-40000.0, -40000.0, 0.0],
+        [2000.0, 2000.0, 0.0],
+    ));
+    h.wake();
+    assert!(h.wait_processed(Duration::from_secs(20)));
+    std::thread::sleep(Duration::from_millis(500));
+    h.poll();
+    let s = h.last_status();
+    assert_eq!(s.messages_rejected, 2);
+    assert_eq!(s.popups_clear, 1);
+    assert_eq!(s.plans_made, 1, "no plan for invalid or clear inputs");
+    assert_eq!(s.current_plan_id, 1);
+    assert_eq!(h.plans.len(), 1);
+    // The valid message's sequence is echoed; the foreign one's is not trusted.
+    assert_eq!(s.last_input_sequence, h.sequence);
+
+    let summary = service.stop(&h);
+    assert_eq!(summary.exit, ExitReason::Requested);
+    assert_eq!(summary.status.plans_made, 1);
+}
+
+#[test]
+fn a_burst_of_popups_is_coalesced_into_few_plans() {
+    let (service, mut h) = first_plan("burst");
+    let plan = h.plans[0].clone();
+    // 50 pop-ups within one second of mission time, each centred on the plan ahead (12
+    // threat ids re-reported at new places: the layout holds 16 threats, 4 are known).
+    let mut last_seq = 0;
+    for k in 0..50 {
+        h.set_time(10.0 + 0.02 * k as f64);
+        let on = state_at(&plan, 60.0 + 8.0 * k as f64).unwrap();
+        let id = 100 + (k % 12) as u32;
+        last_seq = h.send_threat(static_threat(
+            id,
+            [on[0], on[1], 0.0],
+            [1500.0, 1500.0, 0.0],
+        ));
+        h.wake();
+        // Spread over half a second of wall time, so that pop-ups also arrive while a
+        // plan is in flight (a release build plans in a few hundred milliseconds).
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    // Quiet: every input processed, nothing planning, no new plan for a while.
+    assert!(
+        h.wait_until(PLAN_WAIT, |h| h.status.is_some_and(|s| {
+            s.last_input_sequence >= last_seq && s.state() != Some(PlannerState::Planning)
+        })),
+        "the burst was not processed: {:?}",
+        h.status
+    );
+    loop {
+        let made = h.last_status().plans_made;
+        std::thread::sleep(Duration::from_millis(1500));
+        assert!(h.wait_processed(PLAN_WAIT));
+        if h.last_status().plans_made == made {
+            break;
+        }
+    }
+    let s = h.last_status();
+    let burst_plans = s.plans_made - 1;
+    eprintln!(
+        "burst: {burst_plans} plans, coalesced {}, deferred {}, clear {}",
+        s.triggers_coalesced, s.triggers_deferred, s.popups_clear
+    );
+    assert!(
+        (1..=3).contains(&burst_plans),
+        "{burst_plans} plans for one burst"
+    );
+    // Each pop-up either started a plan, was deferred first, or was coalesced.
+    assert!(
+        s.triggers_coalesced + burst_plans + s.triggers_deferred >= 50,
+        "coalesced {} + plans {burst_plans} + deferred {} < 50",
+        s.triggers_coalesced,
+        s.triggers_deferred
+    );
+    assert!(s.triggers_coalesced >= 47 - s.triggers_deferred);
+    assert_eq!(s.messages_rejected, 0);
+    let newest = h.plans.last().unwrap();
+    assert_eq!(newest.plan_id, s.current_plan_id);
+    assert_eq!(newest.trigger(), Some(Trigger::PopUp));
+    assert!(
+        newest.start_time_s >= 10.0,
+        "a re-plan starts at its commit time (now + budget), not in the past"
+    );
+    service.stop(&h);
+}

@@ -1,0 +1,354 @@
+//! A small fake harness for the service tests: it publishes inputs over real iceoryx2
+//! services (through the same QoS helpers as the planner), wakes the planner, and collects
+//! the plans and statuses it publishes. Every test uses its own vehicle id, so parallel
+//! tests never share a service.
+#![allow(dead_code)]
+
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use iceoryx2::node::Node;
+use iceoryx2::port::listener::Listener;
+use iceoryx2::port::notifier::Notifier;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::port::update_connections::UpdateConnections;
+use wingman_interfaces::*;
+use wingman_planner::clock::MonotonicClock;
+use wingman_planner::scenario::Scenario;
+use wingman_planner::service::ipc::{self, Ipc};
+use wingman_planner::service::{RunOptions, RunSummary, ServiceConfig, Shutdown};
+
+/// A vehicle id unique to this process and `tag`.
+pub fn vehicle(tag: &str) -> String {
+    format!("t{}-{tag}", std::process::id())
+}
+
+/// A configuration for tests: generous budgets (a debug build plans ~40x slower than a
+/// release one; a converged plan returns early anyway), a fast heartbeat, short spacing.
+pub fn test_config(vehicle_id: &str) -> ServiceConfig {
+    let mut c = ServiceConfig {
+        vehicle_id: vehicle_id.to_string(),
+        ..ServiceConfig::default()
+    };
+    c.budget.plan_2d_ms = 20_000;
+    c.budget.plan_3d_ms = 20_000;
+    c.budget.min_spacing_ms = 250;
+    c.budget.duty_cycle = 1.0;
+    c.budget.duty_window_ms = 60_000;
+    c.status.heartbeat_ms = 100;
+    c
+}
+
+/// The service running `run(...)` on a thread of this process.
+pub struct ServiceThread {
+    shutdown: Shutdown,
+    thread: Option<JoinHandle<Result<RunSummary, String>>>,
+}
+
+impl ServiceThread {
+    pub fn start(config: ServiceConfig) -> ServiceThread {
+        wingman_planner::logging::init();
+        let shutdown = Shutdown::new();
+        let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
+        let options = RunOptions {
+            config,
+            clock,
+            handle_signals: false,
+            shutdown: shutdown.clone(),
+        };
+        let thread = std::thread::Builder::new()
+            .name("planner-service".into())
+            .spawn(move || {
+                let r = wingman_planner::service::run(options).map_err(|e| e.to_string());
+                if let Err(e) = &r {
+                    eprintln!("the service failed: {e}");
+                }
+                r
+            })
+            .expect("spawn the service thread");
+        ServiceThread {
+            shutdown,
+            thread: Some(thread),
+        }
+    }
+
+    /// Stops the service and returns its summary.
+    pub fn stop(mut self, harness: &FakeHarness) -> RunSummary {
+        self.shutdown.request();
+        harness.wake();
+        let t = self.thread.take().expect("running");
+        t.join()
+            .expect("the service thread panicked")
+            .expect("run failed")
+    }
+}
+
+impl Drop for ServiceThread {
+    fn drop(&mut self) {
+        if let Some(t) = self.thread.take() {
+            self.shutdown.request();
+            // The heartbeat wakes the loop at the latest.
+            let _ = t.join();
+        }
+    }
+}
+
+/// The harness side of the services.
+pub struct FakeHarness {
+    pub vehicle: String,
+    tasking: Publisher<Ipc, Tasking, ()>,
+    route: Publisher<Ipc, LeadRoute, ()>,
+    lead_state: Publisher<Ipc, LeadState, ()>,
+    threats: Publisher<Ipc, ThreatReport, ()>,
+    tracks: Publisher<Ipc, TrackFix, ()>,
+    ownship: Publisher<Ipc, OwnshipState, ()>,
+    plan: Subscriber<Ipc, Plan, ()>,
+    status_sub: Subscriber<Ipc, PlannerStatus, ()>,
+    wake: Notifier<Ipc>,
+    listener: Listener<Ipc>,
+    /// Header sequence of the last input sent (one counter over all inputs).
+    pub sequence: u64,
+    /// Mission time of the next input, ns.
+    pub mission_ns: i64,
+    /// Every plan received, in order.
+    pub plans: Vec<Box<Plan>>,
+    pub status: Option<PlannerStatus>,
+    node: Node<Ipc>,
+}
+
+impl FakeHarness {
+    pub fn new(vehicle: &str) -> FakeHarness {
+        let node = ipc::node(&format!("fake-harness-{vehicle}"), false).unwrap();
+        let v = vehicle;
+        FakeHarness {
+            tasking: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
+            route: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
+            lead_state: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
+            threats: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
+            tracks: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
+            ownship: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
+            plan: ipc::subscriber(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
+            status_sub: ipc::subscriber(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
+            wake: ipc::notifier(
+                &ipc::open_event(&node, v, Service::PlannerWake).unwrap(),
+                ipc::WAKE_INPUT,
+            )
+            .unwrap(),
+            listener: ipc::listener(&ipc::open_event(&node, v, Service::HarnessWake).unwrap())
+                .unwrap(),
+            vehicle: vehicle.to_string(),
+            sequence: 0,
+            mission_ns: 0,
+            plans: Vec::new(),
+            status: None,
+            node,
+        }
+    }
+
+    /// The next input header.
+    pub fn header(&mut self) -> Header {
+        self.sequence += 1;
+        Header::new(SENDER_HARNESS, self.sequence, self.mission_ns)
+    }
+
+    /// Sets the mission clock, s.
+    pub fn set_time(&mut self, t: f64) {
+        self.mission_ns = (t * 1e9).round() as i64;
+    }
+
+    pub fn send_tasking(&mut self, mut m: Tasking) -> u64 {
+        m.header = self.header();
+        self.tasking.send_copy(m).unwrap();
+        m.header.sequence
+    }
+
+    pub fn send_route(&mut self, mut m: LeadRoute) -> u64 {
+        m.header = self.header();
+        self.route.send_copy(m).unwrap();
+        m.header.sequence
+    }
+
+    pub fn send_lead_state(&mut self, mut m: LeadState) -> u64 {
+        m.header = self.header();
+        self.lead_state.send_copy(m).unwrap();
+        m.header.sequence
+    }
+
+    pub fn send_threat(&mut self, mut m: ThreatReport) -> u64 {
+        m.header = self.header();
+        self.threats.send_copy(m).unwrap();
+        m.header.sequence
+    }
+
+    /// Sends a threat report as it is, header included (for invalid messages).
+    pub fn send_threat_raw(&mut self, m: ThreatReport) {
+        self.threats.send_copy(m).unwrap();
+    }
+
+    pub fn send_fix(&mut self, mut m: TrackFix) -> u64 {
+        m.header = self.header();
+        self.tracks.send_copy(m).unwrap();
+        m.header.sequence
+    }
+
+    pub fn send_ownship(&mut self, mut m: OwnshipState) -> u64 {
+        m.header = self.header();
+        self.ownship.send_copy(m).unwrap();
+        m.header.sequence
+    }
+
+    /// Hands the publishers' history to subscribers that joined since their last send (a
+    /// restarted planner), as the harness does every step.
+    pub fn refresh(&self) {
+        let _ = self.tasking.update_connections();
+        let _ = self.route.update_connections();
+        let _ = self.lead_state.update_connections();
+        let _ = self.threats.update_connections();
+        let _ = self.tracks.update_connections();
+        let _ = self.ownship.update_connections();
+    }
+
+    /// Wakes the planner (after publishing).
+    pub fn wake(&self) {
+        self.wake.notify().unwrap();
+    }
+
+    /// Takes the plans and statuses published so far.
+    pub fn poll(&mut self) {
+        let _ = self.plan.update_connections();
+        while let Some(sample) = self.plan.receive().unwrap() {
+            let mut b = Box::<Plan>::new_uninit();
+            // SAFETY: copies one initialised `Plan` into the box's room for one.
+            let b = unsafe {
+                std::ptr::copy_nonoverlapping(sample.payload(), b.as_mut_ptr(), 1);
+                b.assume_init()
+            };
+            b.validate().expect("the planner publishes valid plans");
+            self.plans.push(b);
+        }
+        while let Some(sample) = self.status_sub.receive().unwrap() {
+            let s = *sample.payload();
+            s.validate().expect("the planner publishes valid statuses");
+            self.status = Some(s);
+        }
+    }
+
+    /// Waits (on `wake/harness`) until `done` holds, at most `timeout`.
+    pub fn wait_until(&mut self, timeout: Duration, done: impl Fn(&FakeHarness) -> bool) -> bool {
+        let start = Instant::now();
+        loop {
+            self.poll();
+            if done(self) {
+                return true;
+            }
+            if start.elapsed() > timeout {
+                return false;
+            }
+            let _ = self
+                .listener
+                .timed_wait(|_| {}, Duration::from_millis(50))
+                .unwrap();
+        }
+    }
+
+    /// Waits until the planner has processed every input sent and is not planning.
+    pub fn wait_processed(&mut self, timeout: Duration) -> bool {
+        let seq = self.sequence;
+        self.wait_until(timeout, |h| {
+            h.status.is_some_and(|s| {
+                s.last_input_sequence >= seq && s.state() != Some(PlannerState::Planning)
+            })
+        })
+    }
+
+    /// The newest status (panics if none came).
+    pub fn last_status(&self) -> PlannerStatus {
+        self.status.expect("a status")
+    }
+}
+
+/// The tasking of a scenario (start, targets, final point or rendezvous).
+pub fn tasking_from(sc: &Scenario, revision: u32) -> Tasking {
+    let mut t = Tasking::zeroed();
+    t.revision = revision;
+    t.model = sc.model.to_wire();
+    t.objective = sc.objective.to_wire();
+    t.limits = sc.vehicle;
+    t.weights = sc.weights;
+    let s = &sc.start;
+    t.start_time_s = s.time_s;
+    t.start_state = match sc.model {
+        Model::TwoD => [
+            s.position_m[0],
+            s.position_m[1],
+            s.heading_rad,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        ],
+        Model::ThreeD => [
+            s.position_m[0],
+            s.position_m[1],
+            s.position_m[2],
+            s.gamma_rad,
+            s.heading_rad,
+            1.0,
+            0.0,
+        ],
+    };
+    if let Some(f) = &sc.final_point {
+        t.final_state = match sc.model {
+            Model::TwoD => [
+                f.position_m[0],
+                f.position_m[1],
+                f.heading_rad,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+            ],
+            Model::ThreeD => [
+                f.position_m[0],
+                f.position_m[1],
+                f.position_m[2],
+                f.gamma_rad,
+                f.heading_rad,
+                f.nz,
+                f.mu_rad,
+            ],
+        };
+        t.final_time_s = f.time_s.unwrap_or(0.0);
+    }
+    t.target_count = sc.targets.len() as u32;
+    for (k, p) in sc.targets.iter().enumerate() {
+        t.targets_m[k] = *p;
+    }
+    t
+}
+
+/// A static elliptic threat report.
+pub fn static_threat(id: u32, center: [f64; 3], axes: [f64; 3]) -> ThreatReport {
+    let mut r = ThreatReport::zeroed();
+    r.threat_id = id;
+    r.kind = ThreatKind::Static.to_wire();
+    r.center_m = center;
+    r.axes_m = axes;
+    r.exponents = [2.0, 2.0, if axes[2] > 0.0 { 2.0 } else { 0.0 }];
+    r.name = threat_name(&format!("threat-{id}"));
+    r
+}
+
+/// The static threats of a scenario known at take-off, ids from 1.
+pub fn scenario_threats(sc: &Scenario) -> Vec<ThreatReport> {
+    sc.known_static_threats()
+        .enumerate()
+        .map(|(k, t)| {
+            let mut r = static_threat(k as u32 + 1, t.center_m, t.axes_m);
+            r.exponents = t.exponents;
+            r.yaw_rad = t.yaw_rad;
+            r
+        })
+        .collect()
+}
