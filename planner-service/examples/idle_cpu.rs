@@ -14,6 +14,7 @@
 
 use std::time::{Duration, Instant};
 
+use iceoryx2::port::update_connections::UpdateConnections;
 use wingman_interfaces::*;
 use wingman_planner::clock::MonotonicClock;
 use wingman_planner::scenario::bundled;
@@ -71,7 +72,6 @@ fn main() {
         handle_signals: false,
         shutdown: shutdown.clone(),
     };
-    wingman_planner::logging::init();
     let service = std::thread::spawn(move || wingman_planner::service::run(options));
 
     // A minimal harness: the world, a wake-up, then read the status.
@@ -89,6 +89,15 @@ fn main() {
         ipc::WAKE_INPUT,
     )
     .unwrap();
+    // Wait for the service's first heartbeat: its subscribers exist, so what is sent next
+    // reaches them (a publisher hands its history to late subscribers only when it sends
+    // again or updates its connections).
+    let started = Instant::now();
+    while status.receive().unwrap().is_none() {
+        let _ = status.update_connections();
+        assert!(started.elapsed() < Duration::from_secs(30), "no heartbeat");
+        std::thread::sleep(Duration::from_millis(20));
+    }
     let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();
     let mut seq = 0;
     for (k, t) in sc.known_static_threats().enumerate() {
@@ -138,16 +147,17 @@ fn main() {
     tasking.send_copy(t).unwrap();
     wake.notify().unwrap();
 
-    let started = Instant::now();
     let mut last = None;
     while last.is_none_or(|s: PlannerStatus| {
         s.plans_made == 0 || s.state == PlannerState::Planning.to_wire()
     }) {
         assert!(
             started.elapsed() < Duration::from_secs(120),
-            "no first plan"
+            "no first plan: {last:?}"
         );
         std::thread::sleep(Duration::from_millis(20));
+        let _ = tasking.update_connections();
+        let _ = threats.update_connections();
         while let Some(sample) = status.receive().unwrap() {
             last = Some(*sample.payload());
         }
