@@ -121,25 +121,9 @@ fn main() {
     t.limits = sc.vehicle;
     t.weights = sc.weights;
     let s = &sc.start;
-    t.start_state = [
-        s.position_m[0],
-        s.position_m[1],
-        s.heading_rad,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-    ];
+    t.start_state = s.state(sc.model);
     let f = sc.final_point.as_ref().unwrap();
-    t.final_state = [
-        f.position_m[0],
-        f.position_m[1],
-        f.heading_rad,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-    ];
+    t.final_state = f.state(sc.model);
     t.target_count = sc.targets.len() as u32;
     for (k, p) in sc.targets.iter().enumerate() {
         t.targets_m[k] = *p;

@@ -20,7 +20,6 @@ use crate::collocation::{
     TranscriptionSettings, export, fly, interval_errors, refine, solve,
 };
 use crate::problem::Problem;
-use crate::seeding::{self, Seed};
 use crate::swarm::{self, SwarmOutcome, SwarmSettings, SwarmWorkspace};
 use crate::trajectory::Trajectory;
 
@@ -109,8 +108,6 @@ pub enum PlanError {
     Nlp(#[from] crate::collocation::solve::OptionError),
     #[error("the planner produced a non-finite trajectory")]
     NonFinite,
-    #[error("seeds: {0}")]
-    Seeds(String),
 }
 
 /// Time spent in each stage.
@@ -154,7 +151,6 @@ pub struct PlanOutcome {
 /// The planner with its reusable workspace.
 pub struct Planner {
     swarm: SwarmWorkspace,
-    seeds: Vec<Seed>,
 }
 
 /// One NLP solve's accepted result.
@@ -248,7 +244,6 @@ impl Planner {
     pub fn new(settings: &PlannerSettings) -> Planner {
         Planner {
             swarm: SwarmWorkspace::new(&settings.swarm),
-            seeds: Vec::new(),
         }
     }
 
@@ -287,12 +282,11 @@ impl Planner {
             objective: f64::NAN,
         };
         // Starts from distinct basins, solved side by side on the first mesh.
-        seeding::seeds(problem, &settings.swarm.seeds, &mut self.seeds)
-            .map_err(|e| PlanError::Seeds(e.to_string()))?;
+        // The swarm's workspace holds this problem's seeds: no need to build them again.
         let starts = basins::candidates(
             problem,
             &sw.best,
-            &self.seeds,
+            self.swarm.seeds(),
             settings.starts.max(1),
             |tr| trajectory_cost(problem, tr),
         );

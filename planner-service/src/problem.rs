@@ -179,61 +179,10 @@ impl Problem {
     /// The take-off problem of a scenario: threats known at `start.time_s`, moving threats
     /// from their initial estimate (no fixes), no events.
     pub fn from_scenario(sc: &Scenario) -> Result<Problem, ProblemError> {
-        let v = &sc.vehicle;
-        let limits = match sc.model {
-            Model::TwoD => VehicleLimits::planar(v.speed_mps, v.turn_rate_max_rps)?,
-            Model::ThreeD => VehicleLimits::spatial(SpatialLimits {
-                speed: v.speed_mps,
-                gamma_max: v.gamma_max_rad,
-                nz_min: v.nz_min,
-                nz_max: v.nz_max,
-                mu_max: v.bank_max_rad,
-                nz_rate_max: v.nz_rate_max_per_s,
-                mu_rate_max: v.bank_rate_max_rps,
-                z_min: v.altitude_min_m,
-            })?,
-        };
+        let limits = vehicle_limits(sc.model, &sc.vehicle)?;
         let s = &sc.start;
-        let x0 = match sc.model {
-            Model::TwoD => [
-                s.position_m[0],
-                s.position_m[1],
-                s.heading_rad,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-            ],
-            Model::ThreeD => [
-                s.position_m[0],
-                s.position_m[1],
-                s.position_m[2],
-                s.gamma_rad,
-                s.heading_rad,
-                1.0,
-                0.0,
-            ],
-        };
-        let final_state = sc.final_point.as_ref().map(|f| match sc.model {
-            Model::TwoD => [
-                f.position_m[0],
-                f.position_m[1],
-                f.heading_rad,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-            ],
-            Model::ThreeD => [
-                f.position_m[0],
-                f.position_m[1],
-                f.position_m[2],
-                f.gamma_rad,
-                f.heading_rad,
-                f.nz,
-                f.mu_rad,
-            ],
-        });
+        let x0 = s.state(sc.model);
+        let final_state = sc.final_point.as_ref().map(|f| f.state(sc.model));
         let lead = match &sc.lead {
             Some(l) => Some(LeadPath::new(&l.route_m, l.speed_mps, s.time_s)?),
             None => None,
@@ -341,6 +290,26 @@ impl Problem {
             }
         }
         Ok(())
+    }
+}
+
+/// The model's limits from the wire (and scenario) form, checked.
+pub fn vehicle_limits(
+    model: Model,
+    v: &wingman_interfaces::VehicleLimits,
+) -> Result<VehicleLimits, dynamics::DynamicsError> {
+    match model {
+        Model::TwoD => VehicleLimits::planar(v.speed_mps, v.turn_rate_max_rps),
+        Model::ThreeD => VehicleLimits::spatial(SpatialLimits {
+            speed: v.speed_mps,
+            gamma_max: v.gamma_max_rad,
+            nz_min: v.nz_min,
+            nz_max: v.nz_max,
+            mu_max: v.bank_max_rad,
+            nz_rate_max: v.nz_rate_max_per_s,
+            mu_rate_max: v.bank_rate_max_rps,
+            z_min: v.altitude_min_m,
+        }),
     }
 }
 

@@ -38,6 +38,17 @@ pub struct Start {
     pub gamma_rad: f64,
 }
 
+impl Start {
+    /// The start state in model order, zero-padded to 7 (3-D: level, unbanked flight).
+    pub fn state(&self, model: Model) -> [f64; 7] {
+        let p = &self.position_m;
+        match model {
+            Model::TwoD => [p[0], p[1], self.heading_rad, 0.0, 0.0, 0.0, 0.0],
+            Model::ThreeD => [p[0], p[1], p[2], self.gamma_rad, self.heading_rad, 1.0, 0.0],
+        }
+    }
+}
+
 /// The final point of `fixed-time` and `min-time` missions.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FinalPoint {
@@ -50,6 +61,25 @@ pub struct FinalPoint {
     pub mu_rad: f64,
     /// Fixed final time (`fixed-time` only).
     pub time_s: Option<f64>,
+}
+
+impl FinalPoint {
+    /// The final state in model order, zero-padded to 7.
+    pub fn state(&self, model: Model) -> [f64; 7] {
+        let p = &self.position_m;
+        match model {
+            Model::TwoD => [p[0], p[1], self.heading_rad, 0.0, 0.0, 0.0, 0.0],
+            Model::ThreeD => [
+                p[0],
+                p[1],
+                p[2],
+                self.gamma_rad,
+                self.heading_rad,
+                self.nz,
+                self.mu_rad,
+            ],
+        }
+    }
 }
 
 /// The lead's route for a rendezvous: flown at constant speed from `start.time_s`.

@@ -148,47 +148,14 @@ pub fn fly(problem: &crate::problem::Problem, settings: &ExportSettings, out: &m
     out.controls[0] = u;
     for k in 0..n - 1 {
         let dt = out.times[k + 1] - out.times[k];
-        let predicted = integrate(&vehicle, &x, &u, &u, dt, settings.integration_step_s);
+        let steps = (dt / settings.integration_step_s).ceil() as usize;
+        let predicted = vehicle.integrate_linear(&x, &u, &u, dt, steps);
         let next = tracker.control(&predicted, &reference[k + 1], &feed_forward[k + 1]);
-        x = integrate(&vehicle, &x, &u, &next, dt, settings.integration_step_s);
+        x = vehicle.integrate_linear(&x, &u, &next, dt, steps);
         u = next;
         out.states[k + 1] = x;
         out.controls[k + 1] = u;
     }
-}
-
-/// RK4 over `dt` with the control linear from `ua` to `ub`, in equal steps of at most
-/// `max_step`.
-fn integrate(
-    vehicle: &Vehicle,
-    x0: &[f64; 7],
-    ua: &[f64; 2],
-    ub: &[f64; 2],
-    dt: f64,
-    max_step: f64,
-) -> [f64; 7] {
-    let steps = (dt / max_step).ceil().max(1.0) as usize;
-    let h = dt / steps as f64;
-    let control = |s: f64| -> [f64; 2] {
-        let f = s / dt;
-        [ua[0] + f * (ub[0] - ua[0]), ua[1] + f * (ub[1] - ua[1])]
-    };
-    let rhs = |x: &[f64; 7], u: &[f64; 2]| vehicle.eval(x, u).f;
-    let mut x = *x0;
-    for i in 0..steps {
-        let s = i as f64 * h;
-        let k1 = rhs(&x, &control(s));
-        let x2: [f64; 7] = std::array::from_fn(|c| x[c] + 0.5 * h * k1[c]);
-        let k2 = rhs(&x2, &control(s + 0.5 * h));
-        let x3: [f64; 7] = std::array::from_fn(|c| x[c] + 0.5 * h * k2[c]);
-        let k3 = rhs(&x3, &control(s + 0.5 * h));
-        let x4: [f64; 7] = std::array::from_fn(|c| x[c] + h * k3[c]);
-        let k4 = rhs(&x4, &control(s + h));
-        for c in 0..7 {
-            x[c] += h / 6.0 * (k1[c] + 2.0 * k2[c] + 2.0 * k3[c] + k4[c]);
-        }
-    }
-    x
 }
 
 /// Share of the accumulated mismatch each control sample corrects (0: follow the slope,

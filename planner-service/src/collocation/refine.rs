@@ -70,7 +70,7 @@ pub fn interval_errors(tr: &Transcription, x: &[f64], out: &mut Vec<f64>) {
             } else {
                 ua
             };
-            xk = rk4_linear(tr, &xk, &ua, &ub, tb - ta);
+            xk = tr.vehicle.integrate_linear(&xk, &ua, &ub, tb - ta, 4);
         }
         let end = state(first + n_pts);
         let mut err: f64 = 0.0;
@@ -106,37 +106,6 @@ pub fn interval_errors(tr: &Transcription, x: &[f64], out: &mut Vec<f64>) {
         out.push(err);
         first += n_pts;
     }
-}
-
-fn rk4_linear(
-    tr: &Transcription,
-    x0: &[f64; 7],
-    ua: &[f64; 2],
-    ub: &[f64; 2],
-    dt: f64,
-) -> [f64; 7] {
-    let steps = 4;
-    let h = dt / steps as f64;
-    let u_at = |s: f64| -> [f64; 2] {
-        let f = if dt > 0.0 { s / dt } else { 0.0 };
-        [ua[0] + f * (ub[0] - ua[0]), ua[1] + f * (ub[1] - ua[1])]
-    };
-    let f = |x: &[f64; 7], u: &[f64; 2]| tr.vehicle.eval(x, u).f;
-    let mut x = *x0;
-    for i in 0..steps {
-        let s = i as f64 * h;
-        let k1 = f(&x, &u_at(s));
-        let x2: [f64; 7] = std::array::from_fn(|c| x[c] + 0.5 * h * k1[c]);
-        let k2 = f(&x2, &u_at(s + 0.5 * h));
-        let x3: [f64; 7] = std::array::from_fn(|c| x[c] + 0.5 * h * k2[c]);
-        let k3 = f(&x3, &u_at(s + 0.5 * h));
-        let x4: [f64; 7] = std::array::from_fn(|c| x[c] + h * k3[c]);
-        let k4 = f(&x4, &u_at(s + h));
-        for c in 0..7 {
-            x[c] += h / 6.0 * (k1[c] + 2.0 * k2[c] + 2.0 * k3[c] + k4[c]);
-        }
-    }
-    x
 }
 
 /// The refined mesh, or `None` when every interval is within tolerance (or no phase may

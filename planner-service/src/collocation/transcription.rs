@@ -90,6 +90,50 @@ impl Vehicle {
         }
     }
 
+    /// The right-hand side `f` alone (padded).
+    pub fn rhs(&self, x: &[f64; 7], u: &[f64; 2]) -> [f64; 7] {
+        match self {
+            Vehicle::Planar(m) => {
+                let f = m.rhs(&[x[0], x[1], x[2]], &[u[0]]);
+                [f[0], f[1], f[2], 0.0, 0.0, 0.0, 0.0]
+            }
+            Vehicle::Spatial(m) => m.rhs(x, u),
+        }
+    }
+
+    /// RK4 over `dt` in `steps` equal steps, with the control linear from `ua` to `ub`
+    /// (how a judge or the tracker interpolates sampled controls).
+    pub fn integrate_linear(
+        &self,
+        x0: &[f64; 7],
+        ua: &[f64; 2],
+        ub: &[f64; 2],
+        dt: f64,
+        steps: usize,
+    ) -> [f64; 7] {
+        let steps = steps.max(1);
+        let h = dt / steps as f64;
+        let control = |s: f64| -> [f64; 2] {
+            let f = if dt > 0.0 { s / dt } else { 0.0 };
+            [ua[0] + f * (ub[0] - ua[0]), ua[1] + f * (ub[1] - ua[1])]
+        };
+        let mut x = *x0;
+        for i in 0..steps {
+            let s = i as f64 * h;
+            let k1 = self.rhs(&x, &control(s));
+            let x2: [f64; 7] = std::array::from_fn(|c| x[c] + 0.5 * h * k1[c]);
+            let k2 = self.rhs(&x2, &control(s + 0.5 * h));
+            let x3: [f64; 7] = std::array::from_fn(|c| x[c] + 0.5 * h * k2[c]);
+            let k3 = self.rhs(&x3, &control(s + 0.5 * h));
+            let x4: [f64; 7] = std::array::from_fn(|c| x[c] + h * k3[c]);
+            let k4 = self.rhs(&x4, &control(s + h));
+            for c in 0..7 {
+                x[c] += h / 6.0 * (k1[c] + 2.0 * k2[c] + 2.0 * k3[c] + k4[c]);
+            }
+        }
+        x
+    }
+
     /// `f`, `df/dx`, `df/du`.
     pub fn eval(&self, x: &[f64; 7], u: &[f64; 2]) -> NodeDynamics {
         let mut out = NodeDynamics {

@@ -16,7 +16,7 @@ use wingman_interfaces::{
 
 use super::config::StalenessConfig;
 use super::triggers::{self, RouteDecision, TaskingDecision};
-use crate::dynamics::{DynamicsError, SpatialLimits, VehicleLimits};
+use crate::dynamics::{DynamicsError, VehicleLimits};
 use crate::estimation::{Estimate, EstimationError, GaussMarkov, KalmanFilter, MovingThreat, Road};
 use crate::lead::{LeadError, LeadPath};
 use crate::problem::{CostWeights, Problem, Threats};
@@ -468,20 +468,7 @@ impl World {
         let (Some(model), Some(objective)) = (t.model(), t.objective()) else {
             return Err(BuildError::NoTasking);
         };
-        let l = &t.limits;
-        out.limits = match model {
-            Model::TwoD => VehicleLimits::planar(l.speed_mps, l.turn_rate_max_rps)?,
-            Model::ThreeD => VehicleLimits::spatial(SpatialLimits {
-                speed: l.speed_mps,
-                gamma_max: l.gamma_max_rad,
-                nz_min: l.nz_min,
-                nz_max: l.nz_max,
-                mu_max: l.bank_max_rad,
-                nz_rate_max: l.nz_rate_max_per_s,
-                mu_rate_max: l.bank_rate_max_rps,
-                z_min: l.altitude_min_m,
-            })?,
-        };
+        out.limits = crate::problem::vehicle_limits(model, &t.limits)?;
         out.model = model;
         out.objective = objective;
         out.weights = CostWeights {

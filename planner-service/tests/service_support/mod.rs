@@ -278,47 +278,9 @@ pub fn tasking_from(sc: &Scenario, revision: u32) -> Tasking {
     t.weights = sc.weights;
     let s = &sc.start;
     t.start_time_s = s.time_s;
-    t.start_state = match sc.model {
-        Model::TwoD => [
-            s.position_m[0],
-            s.position_m[1],
-            s.heading_rad,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-        ],
-        Model::ThreeD => [
-            s.position_m[0],
-            s.position_m[1],
-            s.position_m[2],
-            s.gamma_rad,
-            s.heading_rad,
-            1.0,
-            0.0,
-        ],
-    };
+    t.start_state = s.state(sc.model);
     if let Some(f) = &sc.final_point {
-        t.final_state = match sc.model {
-            Model::TwoD => [
-                f.position_m[0],
-                f.position_m[1],
-                f.heading_rad,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-            ],
-            Model::ThreeD => [
-                f.position_m[0],
-                f.position_m[1],
-                f.position_m[2],
-                f.gamma_rad,
-                f.heading_rad,
-                f.nz,
-                f.mu_rad,
-            ],
-        };
+        t.final_state = f.state(sc.model);
         t.final_time_s = f.time_s.unwrap_or(0.0);
     }
     t.target_count = sc.targets.len() as u32;
