@@ -173,6 +173,10 @@ fn solve_on_mesh(
     feasibility_tol: f64,
     deadline: Deadline<'static>,
 ) -> Result<(Option<Solved>, usize, NlpStatus), PlanError> {
+    if deadline.expired() {
+        // No time: do not even build the NLP (the caller returns what it has).
+        return Ok((None, 0, NlpStatus::MaxTime));
+    }
     let mut tr = Transcription::new(problem, mesh, guess, &settings.transcription);
     let mut x = vec![0.0; tr.n_vars()];
     tr.initial_point(guess, &mut x);
@@ -283,13 +287,14 @@ impl Planner {
         };
         // Starts from distinct basins, solved side by side on the first mesh.
         // The swarm's workspace holds this problem's seeds: no need to build them again.
-        let starts = basins::candidates(
-            problem,
-            &sw.best,
-            self.swarm.seeds(),
-            settings.starts.max(1),
-            |tr| trajectory_cost(problem, tr),
-        );
+        let count = if deadline.expired() {
+            1
+        } else {
+            settings.starts.max(1)
+        };
+        let starts = basins::candidates(problem, &sw.best, self.swarm.seeds(), count, |tr| {
+            trajectory_cost(problem, tr)
+        });
         // 1. Rank every start on the coarse mesh.
         let rank = &settings.ranking_mesh;
         let coarse: Vec<Mesh> = starts
