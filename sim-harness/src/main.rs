@@ -5,7 +5,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use wingman_harness::clock::ClockMode;
+use wingman_harness::mission::{self, FlyOptions, PlannerMode};
 use wingman_planner::scenario::load_by_path_or_name;
+use wingman_planner::service::ServiceConfig;
 
 /// Simulation harness of the wingman planner.
 #[derive(Parser)]
@@ -21,6 +24,8 @@ enum Command {
     Fly {
         /// A scenario file in the format of scenarios/FORMAT.md, or a bundled name.
         scenario: String,
+        #[command(flatten)]
+        fly: FlyArgs,
         /// Output folder (default runs/<scenario>/).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -29,8 +34,33 @@ enum Command {
     List,
 }
 
+#[derive(clap::Args, Clone)]
+struct FlyArgs {
+    /// Mission clock: `fast` (lock-step, compute time charged), `realtime`, or `x<K>`.
+    #[arg(long, default_value = "fast")]
+    clock: ClockMode,
+    /// `spawn` starts `wingman-planner serve` (next to this binary); `external` uses a
+    /// planner already serving `--vehicle`.
+    #[arg(long, default_value = "spawn", value_parser = ["spawn", "external"])]
+    planner: String,
+    /// Vehicle id (default: a fresh one per run with `spawn`, `w1` with `external`).
+    #[arg(long)]
+    vehicle: Option<String>,
+    /// Planner configuration for a spawned planner (default: the harness's, with budgets
+    /// that let today's planner converge; written to <out>/planner.toml).
+    #[arg(long, value_name = "FILE")]
+    planner_config: Option<PathBuf>,
+    /// End the flight at this mission time if the plan has not ended, s.
+    #[arg(long)]
+    time_limit: Option<f64>,
+    /// No progress line.
+    #[arg(long)]
+    quiet: bool,
+}
+
 fn main() -> ExitCode {
     wingman_planner::logging::init();
+    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
     match Cli::parse().command {
         Command::List => match wingman_harness::list_bundled() {
             Ok(rows) => {
@@ -44,20 +74,60 @@ fn main() -> ExitCode {
                 ExitCode::from(2)
             }
         },
-        Command::Fly { scenario, out: _ } => match load_by_path_or_name(&scenario) {
-            Ok(sc) => {
-                println!("{sc}");
-                println!(
-                    "The scenario is valid. Flying it end to end (planner and harness \
-                     processes over iceoryx2) is not built yet: see the open issues on the \
-                     planner service and the simulation harness."
-                );
-                ExitCode::SUCCESS
+        Command::Fly { scenario, fly, out } => {
+            let sc = match load_by_path_or_name(&scenario) {
+                Ok(sc) => sc,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(2);
+                }
+            };
+            let mut opts = FlyOptions::new(sc);
+            if let Some(out) = out {
+                opts.out_dir = out;
             }
-            Err(e) => {
+            if let Err(e) = apply(&fly, &mut opts) {
                 eprintln!("error: {e}");
-                ExitCode::from(2)
+                return ExitCode::from(2);
             }
-        },
+            fly_one(&opts)
+        }
+    }
+}
+
+/// Applies the command-line flags to the options.
+fn apply(args: &FlyArgs, opts: &mut FlyOptions) -> Result<(), String> {
+    opts.clock = args.clock;
+    opts.progress = !args.quiet;
+    opts.time_limit_s = args.time_limit;
+    if let Some(path) = &args.planner_config {
+        opts.planner_config = ServiceConfig::load(path).map_err(|e| e.to_string())?;
+    }
+    match args.planner.as_str() {
+        "external" => {
+            opts.planner = PlannerMode::External;
+            opts.planner_config.vehicle_id = args.vehicle.clone().unwrap_or_else(|| "w1".into());
+        }
+        _ => {
+            opts.planner = PlannerMode::Spawn { binary: None };
+            opts.planner_config.vehicle_id = args
+                .vehicle
+                .clone()
+                .unwrap_or_else(|| mission::unique_vehicle_id("fly"));
+        }
+    }
+    opts.planner_config.validate().map_err(|e| e.to_string())
+}
+
+fn fly_one(opts: &FlyOptions) -> ExitCode {
+    match wingman_harness::run_fly(opts) {
+        Ok(summary) => {
+            println!("{summary}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
     }
 }

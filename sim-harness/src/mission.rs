@@ -1,0 +1,521 @@
+//! A mission flown end to end: the planner process (spawned, or one already running), the
+//! emulators (datalink, sensor, tracker) and the clock, step by step, until the flown plan
+//! reaches its end or the time limit. [`fly`] holds the logic; the binary only wires it.
+
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use wingman_interfaces::{Model, PlannerStatus, Quality, Trigger};
+use wingman_planner::estimation::{Estimate, GaussMarkov, KalmanFilter, Road};
+use wingman_planner::problem::{Problem, ProblemError};
+use wingman_planner::scenario::Scenario;
+use wingman_planner::service::ServiceConfig;
+use wingman_planner::service::ipc;
+use wingman_planner::tracking::TrackingGains;
+
+use crate::clock::{ClockMode, Pacer, Periodic, step_time};
+use crate::datalink::{Datalink, DatalinkError};
+use crate::flight_log::{Entry, LogError, LogWriter};
+use crate::link::{LinkError, PlannerLink, Received};
+use crate::process::{PlannerProcess, ProcessError, planner_binary};
+use crate::sensor::{SensorError, SensorOutput, ThreatSensor};
+use crate::tracker::{Hold, InnerLoop, ReceivedPlan, TrackerSample};
+
+/// Where the planner comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PlannerMode {
+    /// Start `wingman-planner serve` (this binary, or the one next to the harness).
+    Spawn { binary: Option<PathBuf> },
+    /// Use a planner already serving the vehicle id.
+    External,
+}
+
+/// Everything a flight needs.
+#[derive(Debug, Clone)]
+pub struct FlyOptions {
+    pub scenario: Scenario,
+    pub clock: ClockMode,
+    pub out_dir: PathBuf,
+    pub planner: PlannerMode,
+    /// The planner's configuration (its `vehicle_id` is the flight's).
+    pub planner_config: ServiceConfig,
+    /// Harness step (tracker, ownship, clock), s.
+    pub step_s: f64,
+    /// Rate of `LeadState`, Hz.
+    pub lead_rate_hz: f64,
+    /// End of the flight if the plan has not ended by then (`None`: three times the first
+    /// plan's duration, at least ten minutes more).
+    pub time_limit_s: Option<f64>,
+    /// Longest wall-clock wait for the planner in one step.
+    pub planner_timeout: Duration,
+    /// Print a progress line on stderr.
+    pub progress: bool,
+}
+
+impl FlyOptions {
+    /// Defaults for `sc`: fast clock, `runs/<name>/`, a spawned planner with
+    /// [`harness_planner_config`] on a fresh vehicle id.
+    pub fn new(sc: Scenario) -> FlyOptions {
+        let vehicle = unique_vehicle_id("fly");
+        FlyOptions {
+            out_dir: PathBuf::from("runs").join(&sc.name),
+            scenario: sc,
+            clock: ClockMode::Fast,
+            planner: PlannerMode::Spawn { binary: None },
+            planner_config: harness_planner_config(&vehicle),
+            step_s: 0.1,
+            lead_rate_hz: 5.0,
+            time_limit_s: None,
+            planner_timeout: Duration::from_secs(300),
+            progress: true,
+        }
+    }
+}
+
+/// The planner configuration the harness flies with: the defaults, with budgets that let
+/// today's planner converge (2 s per 2-D plan, 6 s per 3-D plan; a converged plan returns
+/// early, and the lock-step clock charges the time it took) and no duty-cycle cap beyond
+/// one core over a minute.
+pub fn harness_planner_config(vehicle_id: &str) -> ServiceConfig {
+    let mut c = ServiceConfig {
+        vehicle_id: vehicle_id.to_string(),
+        ..ServiceConfig::default()
+    };
+    c.budget.plan_2d_ms = 2_000;
+    c.budget.plan_3d_ms = 6_000;
+    c.budget.duty_cycle = 1.0;
+    c.budget.duty_window_ms = 60_000;
+    c.status.heartbeat_ms = 200;
+    c
+}
+
+/// A vehicle id no other run on this host uses: `tag`, the process id and a clock reading.
+pub fn unique_vehicle_id(tag: &str) -> String {
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    format!("{tag}-{}-{nanos:x}", std::process::id())
+}
+
+/// A flight could not be flown.
+#[derive(Debug, thiserror::Error)]
+pub enum FlyError {
+    #[error("scenario: {0}")]
+    Problem(#[from] ProblemError),
+    #[error("datalink: {0}")]
+    Datalink(#[from] DatalinkError),
+    #[error("sensor: {0}")]
+    Sensor(#[from] SensorError),
+    #[error("vehicle: {0}")]
+    Vehicle(#[from] wingman_planner::dynamics::DynamicsError),
+    #[error("planner configuration: {0}")]
+    Config(#[from] wingman_planner::service::config::ConfigError),
+    #[error("planner process: {0}")]
+    Process(#[from] ProcessError),
+    #[error("{0}")]
+    Link(#[from] LinkError),
+    #[error("flight log: {0}")]
+    Log(#[from] LogError),
+    #[error("{what}: {source}")]
+    Io {
+        what: String,
+        source: std::io::Error,
+    },
+    #[error("{0}")]
+    Planner(String),
+}
+
+/// How a flight ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EndReason {
+    /// The flown plan reached its end.
+    PlanEnded,
+    /// The time limit came first.
+    TimeLimit,
+}
+
+/// The keep-out estimate of a moving threat when a plan was made.
+#[derive(Debug, Clone, Copy)]
+pub struct EstimateSnapshot {
+    pub plan_id: u64,
+    /// Index of the moving threat (scenario order).
+    pub threat: usize,
+    /// Mission time the region is drawn for (the plan's trigger time).
+    pub at_s: f64,
+    pub estimate: Estimate,
+}
+
+/// What a flight produced.
+#[derive(Debug, Clone)]
+pub struct Flight {
+    pub scenario: Scenario,
+    pub vehicle_id: String,
+    pub clock: ClockMode,
+    pub planner_config: ServiceConfig,
+    /// The tracker after every step, from the start.
+    pub samples: Vec<TrackerSample>,
+    /// Every plan received.
+    pub plans: Vec<ReceivedPlan>,
+    pub holds: Vec<Hold>,
+    /// True positions of each moving threat at every step (`t`, position).
+    pub truth: Vec<Vec<(f64, [f64; 3])>>,
+    /// The moving threats' estimates (the planner's filter, mirrored) at each plan.
+    pub estimates: Vec<EstimateSnapshot>,
+    pub datalink: Datalink,
+    pub end_s: f64,
+    pub end: EndReason,
+    pub last_status: Option<PlannerStatus>,
+    /// Planner messages that failed `validate()`.
+    pub rejected: u64,
+    /// Wall-clock duration of the flight.
+    pub wall: Duration,
+}
+
+/// The moving threats' filters as the planner runs them (same reports, same fixes, same
+/// code), so the plots can show what the planner estimated.
+struct Mirror {
+    filters: Vec<Option<(KalmanFilter, Road<3>, f64)>>,
+}
+
+impl Mirror {
+    fn report(&mut self, k: usize, r: &wingman_interfaces::ThreatReport) {
+        let make = || -> Option<(KalmanFilter, Road<3>, f64)> {
+            let model = GaussMarkov::new(r.accel_tau_s, r.accel_sigma_mps2).ok()?;
+            let road = Road::<3>::new(r.road()).ok()?;
+            let est = Estimate::new(
+                r.estimate_time_s,
+                nalgebra::Vector3::from(r.estimate_mean),
+                nalgebra::Matrix3::from_row_slice(&r.estimate_covariance),
+            )
+            .ok()?;
+            Some((KalmanFilter::new(model, 1.0, est).ok()?, road, 1.0))
+        };
+        if let Some(slot) = self.filters.get_mut(k) {
+            *slot = make();
+        }
+    }
+
+    fn fix(&mut self, k: usize, f: &wingman_interfaces::TrackFix) {
+        let Some(Some((filter, road, sigma))) = self.filters.get_mut(k) else {
+            return;
+        };
+        if f.sigma_m != *sigma
+            && let Ok(nf) = KalmanFilter::new(*filter.model(), f.sigma_m, *filter.estimate())
+        {
+            *filter = nf;
+            *sigma = f.sigma_m;
+        }
+        if filter.predict_to(f.time_s).is_ok() {
+            let _ = filter.update_position(road, &f.position_m);
+        }
+    }
+
+    fn estimate(&self, k: usize) -> Option<Estimate> {
+        self.filters
+            .get(k)
+            .and_then(|f| f.as_ref())
+            .map(|(f, _, _)| *f.estimate())
+    }
+}
+
+/// Flies `opts.scenario` end to end.
+pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
+    let sc = &opts.scenario;
+    let problem = Problem::from_scenario(sc)?;
+    let mut datalink = Datalink::new(sc)?;
+    let mut sensor = ThreatSensor::new(sc)?;
+    let mut tracker = InnerLoop::new(&problem, TrackingGains::default())?;
+    let cfg = &opts.planner_config;
+    cfg.validate()?;
+    let vehicle = cfg.vehicle_id.clone();
+    let io = |what: String| move |source| FlyError::Io { what, source };
+    std::fs::create_dir_all(&opts.out_dir)
+        .map_err(io(format!("create {}", opts.out_dir.display())))?;
+    let config_path = opts.out_dir.join("planner.toml");
+    std::fs::write(&config_path, cfg.to_toml())
+        .map_err(io(format!("write {}", config_path.display())))?;
+    let mut log = LogWriter::create(&opts.out_dir.join("flight.log"))?;
+    log.write(&Entry::Start {
+        version: crate::flight_log::LOG_VERSION,
+        scenario: sc.name.clone(),
+        vehicle_id: vehicle.clone(),
+        clock: opts.clock.to_string(),
+        planner_config: cfg.to_toml(),
+    });
+
+    let cleanup = ipc::remove_dead_nodes(Duration::from_secs(1)).map_err(LinkError::from)?;
+    if cleanup.removed > 0 {
+        tracing::info!(removed = cleanup.removed, "removed dead iceoryx2 nodes");
+    }
+    let mut planner = match &opts.planner {
+        PlannerMode::Spawn { binary } => {
+            let bin = match binary {
+                Some(b) => b.clone(),
+                None => planner_binary()?,
+            };
+            let p = PlannerProcess::spawn(
+                &bin,
+                &config_path,
+                &vehicle,
+                &opts.out_dir.join("planner.log"),
+            )?;
+            tracing::info!(pid = p.id(), vehicle = %vehicle, "planner started");
+            Some(p)
+        }
+        PlannerMode::External => None,
+    };
+    let mut link = PlannerLink::open(&vehicle, log)?;
+    let wall_start = Instant::now();
+
+    // The planner is up (and subscribed) once its heartbeat arrives.
+    let up = Instant::now();
+    while link.status().is_none() {
+        link.poll()?;
+        if planner.as_mut().is_some_and(|p| !p.is_running()) {
+            return Err(FlyError::Planner(format!(
+                "the planner exited at start-up (see {})",
+                opts.out_dir.join("planner.log").display()
+            )));
+        }
+        if up.elapsed() > Duration::from_secs(30) {
+            return Err(FlyError::Planner(format!(
+                "no status from a planner on vehicle `{vehicle}` within 30 s"
+            )));
+        }
+        link.wait(Duration::from_millis(100))?;
+    }
+
+    let t0 = sc.start.time_s;
+    let dt = opts.step_s;
+    let mut lead_tick = Periodic::new(t0, 1.0 / opts.lead_rate_hz);
+    let mut mirror = Mirror {
+        filters: vec![None; sc.moving_threats.len()],
+    };
+    let moving_base = sensor.static_count() as u32 + 1;
+    let mut truth: Vec<Vec<(f64, [f64; 3])>> = vec![Vec::new(); sc.moving_threats.len()];
+    let mut estimates = Vec::new();
+    let mut samples = vec![tracker.sample()];
+    let mut rejected = 0;
+    let mut progress = Progress::new(opts.progress);
+    let pacer = Pacer::new(opts.clock, t0);
+    let mut time_limit = opts.time_limit_s.unwrap_or(t0 + 7200.0);
+    let mut k: u64 = 0;
+    let mut t = t0;
+
+    let end = loop {
+        // 1. This step's inputs.
+        link.set_time(t);
+        link.refresh();
+        for out in sensor.poll(t) {
+            match out {
+                SensorOutput::Report(r) => {
+                    if r.threat_id >= moving_base {
+                        mirror.report((r.threat_id - moving_base) as usize, &r);
+                    }
+                    link.send_threat(r)?;
+                }
+                SensorOutput::Fix(f) => {
+                    mirror.fix((f.threat_id.saturating_sub(moving_base)) as usize, &f);
+                    link.send_fix(f)?;
+                }
+            }
+        }
+        for (i, m) in sensor.movings().iter().enumerate() {
+            truth[i].push((t, m.true_position()));
+        }
+        for r in datalink.routes_due(t).to_vec() {
+            link.send_route(r.message)?;
+        }
+        for r in datalink.taskings_due(t).to_vec() {
+            link.send_tasking(r.tasking)?;
+        }
+        if lead_tick.due(t).is_some()
+            && let Some(s) = datalink.lead_state(t)
+        {
+            link.send_lead_state(s)?;
+        }
+        link.send_ownship(tracker.ownship())?;
+        link.wake()?;
+
+        // 2. The planner's answer: lock-step waits for it.
+        let received: Received = if opts.clock.is_lock_step() {
+            let (r, ok) = link.sync(opts.planner_timeout, || {
+                planner.as_mut().is_none_or(|p| p.is_running())
+            })?;
+            if !ok {
+                let why = if planner.as_mut().is_some_and(|p| !p.is_running()) {
+                    "the planner process exited".to_string()
+                } else {
+                    format!("no answer within {:?}", opts.planner_timeout)
+                };
+                return Err(FlyError::Planner(format!(
+                    "{why} at mission time {t:.1} s (see {})",
+                    opts.out_dir.join("planner.log").display()
+                )));
+            }
+            r
+        } else {
+            link.poll()?
+        };
+        rejected += received.rejected;
+        for plan in received.plans {
+            let available_at_s = match (opts.clock.is_lock_step(), plan.trigger()) {
+                (_, Some(Trigger::Initial)) => plan.start_time_s.min(t).max(t0),
+                (true, _) => (plan.created_at_s + plan.compute_ms / 1e3).max(t),
+                (false, _) => t,
+            };
+            for (i, _) in sc.moving_threats.iter().enumerate() {
+                if let Some(e) = mirror.estimate(i) {
+                    estimates.push(EstimateSnapshot {
+                        plan_id: plan.plan_id,
+                        threat: i,
+                        at_s: plan.created_at_s,
+                        estimate: e,
+                    });
+                }
+            }
+            if tracker.plans().is_empty() && opts.time_limit_s.is_none() {
+                let duration = plan.final_time_s - t0;
+                time_limit = t0 + (3.0 * duration).max(duration + 600.0);
+            }
+            tracing::info!(
+                plan_id = plan.plan_id,
+                trigger = plan.trigger().map_or("?", Trigger::name),
+                quality = plan.quality().map_or("?", Quality::name),
+                start_s = plan.start_time_s,
+                available_at_s,
+                compute_ms = plan.compute_ms,
+                "plan received"
+            );
+            tracker.receive(ReceivedPlan {
+                plan,
+                received_at_s: t,
+                available_at_s,
+            });
+        }
+        progress.show(sc, t, &tracker, false);
+
+        // 3. The end, or the next step.
+        if tracker.plan_finished() {
+            break EndReason::PlanEnded;
+        }
+        if t >= time_limit {
+            break EndReason::TimeLimit;
+        }
+        k += 1;
+        t = step_time(t0, dt, k);
+        pacer.sleep_until(t);
+        tracker.advance_to(t);
+        samples.push(tracker.sample());
+    };
+    progress.show(sc, t, &tracker, true);
+
+    link.log.write(&Entry::End {
+        mission_s: t,
+        completed: end == EndReason::PlanEnded,
+    });
+    link.log.flush()?;
+    let last_status = link.status().copied();
+    drop(link);
+    if let Some(p) = planner.as_mut()
+        && let Some(status) = p.stop(Duration::from_secs(10))
+        && !status.success()
+    {
+        tracing::warn!(?status, "the planner exited with an error");
+    }
+    Ok(Flight {
+        scenario: sc.clone(),
+        vehicle_id: vehicle,
+        clock: opts.clock,
+        planner_config: cfg.clone(),
+        samples,
+        plans: tracker.plans().to_vec(),
+        holds: tracker.holds().to_vec(),
+        truth,
+        estimates,
+        datalink,
+        end_s: t,
+        end,
+        last_status,
+        rejected,
+        wall: wall_start.elapsed(),
+    })
+}
+
+/// The progress line: mission time, phase, plan flown, re-plans so far.
+struct Progress {
+    on: bool,
+    tty: bool,
+    last: Option<Instant>,
+    last_t: f64,
+}
+
+impl Progress {
+    fn new(on: bool) -> Progress {
+        Progress {
+            on,
+            tty: std::io::stderr().is_terminal(),
+            last: None,
+            last_t: f64::NEG_INFINITY,
+        }
+    }
+
+    fn show(&mut self, sc: &Scenario, t: f64, tracker: &InnerLoop, last: bool) {
+        if !self.on {
+            return;
+        }
+        let due = if self.tty {
+            self.last
+                .is_none_or(|l| l.elapsed() > Duration::from_millis(200))
+        } else {
+            t - self.last_t >= 60.0
+        };
+        if !due && !last {
+            return;
+        }
+        self.last = Some(Instant::now());
+        self.last_t = t;
+        let phase = match tracker.flying() {
+            None => "waiting for the first plan".to_string(),
+            Some(p) => {
+                let ends = p.plan.phase_ends();
+                let left = ends.iter().filter(|&&e| e > t).count();
+                let goal = match sc.objective {
+                    wingman_interfaces::Objective::MinTimeRendezvous => "rendezvous",
+                    _ => "final point",
+                };
+                if left > 1 {
+                    format!("{} target(s) left, then the {goal}", left - 1)
+                } else {
+                    format!("last leg, to the {goal}")
+                }
+            }
+        };
+        let plans = tracker.plans().len();
+        let flying = tracker.flying().map_or(0, |p| p.plan.plan_id);
+        let hold = if tracker.holding() { "  HOLD" } else { "" };
+        let line = format!(
+            "{}  t = {t:7.1} s  {phase:<34}  plan {flying} ({} re-plans){hold}",
+            sc.name,
+            plans.saturating_sub(1)
+        );
+        let mut err = std::io::stderr();
+        if self.tty {
+            let _ = write!(err, "\r{line:<110}");
+            if last {
+                let _ = writeln!(err);
+            }
+        } else {
+            let _ = writeln!(err, "{line}");
+        }
+    }
+}
+
+/// Position of a state (z = 0 in 2-D).
+pub fn position(model: Model, x: &[f64; 7]) -> [f64; 3] {
+    match model {
+        Model::TwoD => [x[0], x[1], 0.0],
+        Model::ThreeD => [x[0], x[1], x[2]],
+    }
+}
