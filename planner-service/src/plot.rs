@@ -10,7 +10,9 @@ use crate::problem::{Problem, Threats};
 
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
-fn register_font() {
+/// Registers the bundled DejaVu Sans as plotters' `sans-serif` (once; other plots of the
+/// workspace, e.g. the harness's, call it too).
+pub fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // The bundled font is a valid TrueType file; a failure would only lose the text.

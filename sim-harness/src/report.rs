@@ -5,7 +5,7 @@
 
 use serde::Serialize;
 use wingman_interfaces::{Model, Objective, Quality, Trigger};
-use wingman_planner::metrics::{TargetMiss, simpson_by, target_misses};
+use wingman_planner::metrics::{TargetMiss, simpson, target_misses};
 use wingman_planner::threat::{ExposureAcc, Superquadric, ThreatError, ThreatLayout};
 
 use crate::mission::{EndReason, Flight, position};
@@ -175,6 +175,43 @@ fn seg_dist(a: &[f64; 3], b: &[f64; 3], p: &[f64; 3]) -> f64 {
     (r[0] - s * d[0]).hypot(r[1] - s * d[1])
 }
 
+fn flown_positions<const D: usize>(flight: &Flight) -> Vec<[f64; D]> {
+    flight
+        .samples
+        .iter()
+        .map(|x| {
+            let p = position(flight.scenario.model, &x.state);
+            std::array::from_fn(|i| p[i])
+        })
+        .collect()
+}
+
+/// `E` against the truth at every flown sample.
+fn exposure_in<const D: usize>(flight: &Flight, tr: &Truth<D>, pos: &[[f64; D]]) -> Vec<f64> {
+    let s = flight.scenario.weights.stiffness;
+    let movings = flight.scenario.moving_threats.len();
+    (0..pos.len())
+        .map(|k| {
+            let mut acc = ExposureAcc::<D>::new();
+            tr.layout.fold_value_into(&pos[k], &mut acc);
+            for i in 0..movings {
+                if let Some(q) = moving_region::<D>(flight, i, k) {
+                    acc.fold_value(q.f(&pos[k]), s);
+                }
+            }
+            acc.e.value
+        })
+        .collect()
+}
+
+/// The exposure `E` against the truth at every sample of `flight.samples`.
+pub fn exposure_series(flight: &Flight) -> Result<Vec<f64>, ThreatError> {
+    Ok(match flight.scenario.model {
+        Model::TwoD => exposure_in::<2>(flight, &truth::<2>(flight)?, &flown_positions(flight)),
+        Model::ThreeD => exposure_in::<3>(flight, &truth::<3>(flight)?, &flown_positions(flight)),
+    })
+}
+
 struct PathMetrics {
     exposure: f64,
     threats: Vec<ThreatOutcome>,
@@ -184,27 +221,10 @@ struct PathMetrics {
 fn path_metrics<const D: usize>(flight: &Flight) -> Result<PathMetrics, ThreatError> {
     let sc = &flight.scenario;
     let tr = truth::<D>(flight)?;
-    let s = sc.weights.stiffness;
     let times: Vec<f64> = flight.samples.iter().map(|x| x.t).collect();
-    let pos: Vec<[f64; D]> = flight
-        .samples
-        .iter()
-        .map(|x| {
-            let p = position(sc.model, &x.state);
-            std::array::from_fn(|i| p[i])
-        })
-        .collect();
-    let movings = sc.moving_threats.len();
-    let exposure = simpson_by(&times, |k| {
-        let mut acc = ExposureAcc::<D>::new();
-        tr.layout.fold_value_into(&pos[k], &mut acc);
-        for i in 0..movings {
-            if let Some(q) = moving_region::<D>(flight, i, k) {
-                acc.fold_value(q.f(&pos[k]), s);
-            }
-        }
-        acc.e.value
-    });
+    let pos: Vec<[f64; D]> = flown_positions(flight);
+    let series = exposure_in::<D>(flight, &tr, &pos);
+    let exposure = simpson(&times, &series);
     let mut threats = Vec::new();
     for (name, q) in &tr.statics {
         let best = pos
