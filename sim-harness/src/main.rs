@@ -30,6 +30,15 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Feeds a flight log's planner inputs to the planner in-process and checks that
+    /// every plan comes out byte-identical (exit 1 if not).
+    Replay {
+        /// A `flight.log` written by `fly`.
+        log: PathBuf,
+        /// Longest wait for the planner at one step, s.
+        #[arg(long, default_value_t = 300)]
+        timeout_s: u64,
+    },
     /// Lists the bundled scenarios with their summaries.
     List,
 }
@@ -74,6 +83,22 @@ fn main() -> ExitCode {
                 ExitCode::from(2)
             }
         },
+        Command::Replay { log, timeout_s } => {
+            match wingman_harness::replay::replay(&log, std::time::Duration::from_secs(timeout_s)) {
+                Ok(o) => {
+                    println!("{o}");
+                    if o.all_identical() {
+                        ExitCode::SUCCESS
+                    } else {
+                        ExitCode::from(1)
+                    }
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(2)
+                }
+            }
+        }
         Command::Fly { scenario, fly, out } => {
             let sc = match load_by_path_or_name(&scenario) {
                 Ok(sc) => sc,

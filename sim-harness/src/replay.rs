@@ -1,1 +1,286 @@
-//! placeholder
+//! `replay`: a flown `flight.log` fed back to the planner, in-process. The planner service
+//! (`wingman_planner::service::run`, the very code `wingman-planner serve` runs) starts on
+//! a thread with the logged configuration on a fresh vehicle id; the logged inputs are
+//! published as they were (headers included) and, at every logged lock-step barrier, the
+//! replay waits as the flight did until the planner has processed them and is idle. Every
+//! plan that comes out is compared with the logged one **byte for byte**, except
+//! `compute_ms` (a wall-clock measurement): same inputs and seed, same plan.
+//!
+//! A log flown with the lock-step clock replays exactly. A real-time log has no barriers:
+//! the replay then syncs after each mission time's inputs, which need not be how the
+//! planner saw them in flight, and says so.
+
+use std::mem::offset_of;
+use std::path::Path;
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use wingman_interfaces::{Plan, Wire};
+use wingman_planner::clock::MonotonicClock;
+use wingman_planner::service::{RunOptions, ServiceConfig, Shutdown};
+
+use crate::flight_log::{self, Direction, Entry, Kind, LogWriter};
+use crate::link::PlannerLink;
+use crate::mission::unique_vehicle_id;
+
+/// A replay that could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    #[error("{0}")]
+    Log(#[from] flight_log::LogError),
+    #[error("the logged planner configuration: {0}")]
+    Config(#[from] wingman_planner::service::config::ConfigError),
+    #[error("{0}")]
+    Link(#[from] crate::link::LinkError),
+    #[error("the planner service: {0}")]
+    Service(String),
+}
+
+/// One plan that came out different.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mismatch {
+    pub plan_id: u64,
+    /// The fields whose bytes differ (`compute_ms` ignored).
+    pub fields: Vec<&'static str>,
+}
+
+/// What a replay found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReplayOutcome {
+    pub scenario: String,
+    /// The log has lock-step barriers (a fast-clock flight).
+    pub lock_step: bool,
+    pub inputs: usize,
+    pub plans_logged: usize,
+    pub plans_replayed: usize,
+    /// Plans identical byte for byte (except `compute_ms`).
+    pub identical: usize,
+    pub mismatches: Vec<Mismatch>,
+}
+
+impl ReplayOutcome {
+    /// Every logged plan came out identical, and no other plan came out.
+    pub fn all_identical(&self) -> bool {
+        self.plans_logged == self.plans_replayed
+            && self.identical == self.plans_logged
+            && self.mismatches.is_empty()
+    }
+}
+
+impl std::fmt::Display for ReplayOutcome {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(
+            f,
+            "{}: {} inputs replayed{}, {} plan(s) logged, {} replayed, {} identical byte for byte \
+             (compute_ms aside)",
+            self.scenario,
+            self.inputs,
+            if self.lock_step {
+                " in lock-step"
+            } else {
+                " (real-time log: no lock-step barriers, synced per mission time)"
+            },
+            self.plans_logged,
+            self.plans_replayed,
+            self.identical
+        )?;
+        for m in &self.mismatches {
+            writeln!(
+                f,
+                "  plan {} differs in: {}",
+                m.plan_id,
+                m.fields.join(", ")
+            )?;
+        }
+        write!(
+            f,
+            "{}",
+            if self.all_identical() {
+                "every plan identical"
+            } else {
+                "PLANS DIFFER"
+            }
+        )
+    }
+}
+
+/// The service on a thread of this process; stopped in `Drop`.
+struct InProcessPlanner {
+    shutdown: Shutdown,
+    thread: Option<JoinHandle<Result<(), String>>>,
+}
+
+impl InProcessPlanner {
+    fn start(config: ServiceConfig) -> Result<InProcessPlanner, ReplayError> {
+        let shutdown = Shutdown::new();
+        let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
+        let options = RunOptions {
+            config,
+            clock,
+            handle_signals: false,
+            shutdown: shutdown.clone(),
+        };
+        let thread = std::thread::Builder::new()
+            .name("planner-service".into())
+            .spawn(move || {
+                wingman_planner::service::run(options)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
+            })
+            .map_err(|e| ReplayError::Service(e.to_string()))?;
+        Ok(InProcessPlanner {
+            shutdown,
+            thread: Some(thread),
+        })
+    }
+
+    fn is_running(&self) -> bool {
+        self.thread.as_ref().is_some_and(|t| !t.is_finished())
+    }
+
+    fn stop(&mut self, link: &PlannerLink) -> Result<(), ReplayError> {
+        self.shutdown.request();
+        let _ = link.wake();
+        match self.thread.take().map(JoinHandle::join) {
+            Some(Ok(Err(e))) => Err(ReplayError::Service(e)),
+            Some(Err(_)) => Err(ReplayError::Service("the service thread panicked".into())),
+            _ => Ok(()),
+        }
+    }
+}
+
+impl Drop for InProcessPlanner {
+    fn drop(&mut self) {
+        if let Some(t) = self.thread.take() {
+            self.shutdown.request();
+            // The heartbeat wakes the loop at the latest.
+            let _ = t.join();
+        }
+    }
+}
+
+/// The bytes of a plan with `compute_ms` zeroed.
+fn comparable(plan: &Plan) -> Vec<u8> {
+    let mut b = plan.as_bytes().to_vec();
+    let at = offset_of!(Plan, compute_ms);
+    b[at..at + 8].fill(0);
+    b
+}
+
+/// The fields of `Plan` whose bytes differ between `a` and `b`.
+fn differing_fields(a: &[u8], b: &[u8]) -> Vec<&'static str> {
+    Plan::fields()
+        .iter()
+        .filter(|f| {
+            let r = f.offset..f.offset + f.size;
+            a.get(r.clone()) != b.get(r)
+        })
+        .map(|f| f.name)
+        .collect()
+}
+
+/// Replays `log` (see the module documentation). `timeout`: the longest wait for the
+/// planner at one barrier.
+pub fn replay(log: &Path, timeout: Duration) -> Result<ReplayOutcome, ReplayError> {
+    let entries = flight_log::read(log)?;
+    let (scenario, config_text) = match entries.first() {
+        Some(Entry::Start {
+            scenario,
+            planner_config,
+            ..
+        }) => (scenario.clone(), planner_config.clone()),
+        _ => unreachable!("flight_log::read checks the start record"),
+    };
+    let mut config = ServiceConfig::from_toml(&config_text, "flight.log (planner_config)")?;
+    config.vehicle_id = unique_vehicle_id("replay");
+    let lock_step = entries.iter().any(|e| matches!(e, Entry::Sync { .. }));
+    let logged: Vec<Box<Plan>> = entries
+        .iter()
+        .filter_map(|e| match e {
+            Entry::Message {
+                direction: Direction::FromPlanner,
+                kind: Kind::Plan,
+                bytes,
+                ..
+            } => flight_log::decode_plan(bytes),
+            _ => None,
+        })
+        .collect();
+
+    let mut link = PlannerLink::open(&config.vehicle_id, LogWriter::discard())?;
+    let mut planner = InProcessPlanner::start(config)?;
+    let mut replayed: Vec<Box<Plan>> = Vec::new();
+    let up = std::time::Instant::now();
+    while link.status().is_none() {
+        link.poll()?;
+        if !planner.is_running() || up.elapsed() > Duration::from_secs(30) {
+            return Err(ReplayError::Service("the service did not start".into()));
+        }
+        link.wait(Duration::from_millis(50))?;
+    }
+    let mut inputs = 0;
+    let mut group_time: Option<f64> = None;
+    let barrier = |link: &mut PlannerLink,
+                   replayed: &mut Vec<Box<Plan>>,
+                   planner: &InProcessPlanner|
+     -> Result<(), ReplayError> {
+        link.wake()?;
+        let (r, ok) = link.sync(timeout, || planner.is_running())?;
+        replayed.extend(r.plans);
+        if ok {
+            Ok(())
+        } else {
+            Err(ReplayError::Service(format!(
+                "the planner did not process the inputs within {timeout:?}"
+            )))
+        }
+    };
+    for e in &entries {
+        match e {
+            Entry::Message {
+                direction: Direction::ToPlanner,
+                kind,
+                bytes,
+                mission_s,
+                ..
+            } => {
+                if !lock_step {
+                    if group_time.is_some_and(|t| t != *mission_s) {
+                        barrier(&mut link, &mut replayed, &planner)?;
+                    }
+                    group_time = Some(*mission_s);
+                }
+                if link.send_logged(*kind, bytes)? {
+                    inputs += 1;
+                }
+            }
+            Entry::Sync { .. } => barrier(&mut link, &mut replayed, &planner)?,
+            _ => {}
+        }
+    }
+    barrier(&mut link, &mut replayed, &planner)?;
+    planner.stop(&link)?;
+
+    let mut identical = 0;
+    let mut mismatches = Vec::new();
+    for (a, b) in logged.iter().zip(&replayed) {
+        let (ba, bb) = (comparable(a), comparable(b));
+        if ba == bb {
+            identical += 1;
+        } else {
+            mismatches.push(Mismatch {
+                plan_id: a.plan_id,
+                fields: differing_fields(&ba, &bb),
+            });
+        }
+    }
+    Ok(ReplayOutcome {
+        scenario,
+        lock_step,
+        inputs,
+        plans_logged: logged.len(),
+        plans_replayed: replayed.len(),
+        identical,
+        mismatches,
+    })
+}
