@@ -19,6 +19,7 @@
 pub mod clock;
 pub mod datalink;
 pub mod flight_log;
+pub mod fly_all;
 pub mod link;
 pub mod mission;
 pub mod plots;
@@ -43,8 +44,8 @@ pub fn list_bundled() -> Result<Vec<(String, String)>, ScenarioError> {
 }
 
 /// Flies a mission and writes its outputs (`report.json`, `flight.log`, the plots) into
-/// `opts.out_dir`; returns a one-paragraph summary.
-pub fn run_fly(opts: &mission::FlyOptions) -> anyhow::Result<String> {
+/// `opts.out_dir`; returns the report and a one-paragraph summary.
+pub fn run_fly(opts: &mission::FlyOptions) -> anyhow::Result<(report::Report, String)> {
     use anyhow::Context;
     let flight = mission::fly(opts)?;
     let report = report::build(&flight).context("report")?;
@@ -53,7 +54,8 @@ pub fn run_fly(opts: &mission::FlyOptions) -> anyhow::Result<String> {
     std::fs::write(&path, json + "\n").with_context(|| format!("write {}", path.display()))?;
     let pngs = plots::draw_all(&flight, &report, &opts.out_dir)
         .map_err(|e| anyhow::anyhow!("plots: {e}"))?;
-    Ok(summary(&report, &opts.out_dir, &pngs))
+    let text = summary(&report, &opts.out_dir, &pngs);
+    Ok((report, text))
 }
 
 /// The lines `fly` prints at the end.

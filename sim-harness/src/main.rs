@@ -39,6 +39,21 @@ enum Command {
         #[arg(long, default_value_t = 300)]
         timeout_s: u64,
     },
+    /// Flies every canonical scenario (`scenarios/*.toml`, else the bundled ones), replays
+    /// each log, and prints the table of outcomes (Markdown); exit 1 if any fails.
+    FlyAll {
+        #[command(flatten)]
+        fly: FlyArgs,
+        /// Folder of the scenarios.
+        #[arg(long, default_value = "scenarios")]
+        scenarios: PathBuf,
+        /// Each flight's outputs go to <OUT_ROOT>/<scenario>/.
+        #[arg(long, default_value = "runs")]
+        out_root: PathBuf,
+        /// Skip the replays.
+        #[arg(long)]
+        no_replay: bool,
+    },
     /// Lists the bundled scenarios with their summaries.
     List,
 }
@@ -83,6 +98,36 @@ fn main() -> ExitCode {
                 ExitCode::from(2)
             }
         },
+        Command::FlyAll {
+            fly,
+            scenarios,
+            out_root,
+            no_replay,
+        } => {
+            let all = match wingman_harness::fly_all::canonical(&scenarios) {
+                Ok(all) if !all.is_empty() => all,
+                Ok(_) => {
+                    eprintln!("error: no scenarios in {}", scenarios.display());
+                    return ExitCode::from(2);
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(2);
+                }
+            };
+            let mut opts = FlyOptions::new(all[0].clone());
+            if let Err(e) = apply(&fly, &mut opts) {
+                eprintln!("error: {e}");
+                return ExitCode::from(2);
+            }
+            let rows = wingman_harness::fly_all::fly_all(&all, &opts, &out_root, !no_replay);
+            print!("{}", wingman_harness::fly_all::table(&rows));
+            if rows.iter().all(|r| r.passes()) {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }
         Command::Replay { log, timeout_s } => {
             match wingman_harness::replay::replay(&log, std::time::Duration::from_secs(timeout_s)) {
                 Ok(o) => {
@@ -146,7 +191,7 @@ fn apply(args: &FlyArgs, opts: &mut FlyOptions) -> Result<(), String> {
 
 fn fly_one(opts: &FlyOptions) -> ExitCode {
     match wingman_harness::run_fly(opts) {
-        Ok(summary) => {
+        Ok((_, summary)) => {
             println!("{summary}");
             ExitCode::SUCCESS
         }

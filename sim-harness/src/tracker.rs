@@ -170,7 +170,11 @@ impl InnerLoop {
             // mission is over there (`plan_finished`).
             Some(p) => {
                 let reaches_end = p.plan.valid_until_s >= p.plan.final_time_s - EPS_S;
-                !reaches_end && self.t > p.plan.valid_until_s + EPS_S && !newer_received
+                // Past valid-until the plan may still be flown until a successor that
+                // was received starts; a hold, once begun, lasts until one starts.
+                !reaches_end
+                    && self.t > p.plan.valid_until_s + EPS_S
+                    && (!newer_received || self.holding())
             }
         };
         match (hold, self.holding()) {
