@@ -298,7 +298,7 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
     let mut samples = vec![tracker.sample()];
     let mut rejected = 0;
     let mut progress = Progress::new(opts.progress);
-    let pacer = Pacer::new(opts.clock, t0);
+    let mut pacer = Pacer::new(opts.clock, t0);
     let mut time_limit = opts.time_limit_s.unwrap_or(t0 + 7200.0);
     let mut k: u64 = 0;
     let mut t = t0;
@@ -339,7 +339,9 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
         link.wake()?;
 
         // 2. The planner's answer: lock-step waits for it.
-        let received: Received = if opts.clock.is_lock_step() {
+        // Every clock waits for the first plan at take-off (it is planned before the
+        // flight); the paced clocks start after it.
+        let received: Received = if opts.clock.is_lock_step() || k == 0 {
             let (r, ok) = link.sync(opts.planner_timeout, || {
                 planner.as_mut().is_none_or(|p| p.is_running())
             })?;
@@ -353,6 +355,9 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
                     "{why} at mission time {t:.1} s (see {})",
                     opts.out_dir.join("planner.log").display()
                 )));
+            }
+            if k == 0 {
+                pacer = Pacer::new(opts.clock, t0);
             }
             r
         } else {

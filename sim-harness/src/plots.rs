@@ -321,13 +321,7 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
     .label("E (truth: every static threat, moving threats at their true position)")
     .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RGBColor(200, 40, 30)));
     replan_lines(&mut c, flight, (0.0, e_max))?;
-    c.configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(boxed)?;
+    legend(&mut c)?;
 
     // 2. Deviation.
     let three_d = flight.scenario.model == Model::ThreeD;
@@ -384,13 +378,7 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
         .map_err(boxed)?;
     }
     replan_lines(&mut c, flight, (-d_max, d_max))?;
-    c.configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(boxed)?;
+    legend(&mut c)?;
 
     // 3. Plans: which one is flown, and the compute time of each.
     let n = flight.plans.len().max(1) as f64;
@@ -443,13 +431,30 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
     Ok(())
 }
 
+/// The chart of the timeline and the side view.
+type Chart<'a, DB> = ChartContext<
+    'a,
+    DB,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// The legend, upper right.
+fn legend<'a, DB: DrawingBackend + 'a>(c: &mut Chart<'a, DB>) -> PlotResult<()>
+where
+    DB::ErrorType: 'static,
+{
+    c.configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 14))
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(|e| boxed(format!("{e:?}")))
+}
+
 /// A dotted vertical line at each re-plan's trigger time.
 fn replan_lines<DB: DrawingBackend>(
-    c: &mut ChartContext<
-        '_,
-        DB,
-        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
-    >,
+    c: &mut Chart<'_, DB>,
     flight: &Flight,
     (lo, hi): (f64, f64),
 ) -> PlotResult<()>
@@ -577,13 +582,7 @@ pub fn side(flight: &Flight, path: &Path) -> PlotResult<()> {
             .map_err(boxed)?;
         }
     }
-    c.configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(boxed)?;
+    legend(&mut c)?;
     root.present().map_err(boxed)?;
     Ok(())
 }
