@@ -141,9 +141,8 @@ pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
         label: Some("flown path".into()),
         color: BLACK,
         stroke: Stroke::Bold,
-        points: flight
-            .samples
-            .iter()
+        // One point a second: a thick line through every 0.1 s step renders jagged.
+        points: decimated(flight)
             .map(|s| [s.state[0], s.state[1]])
             .collect(),
     });
@@ -233,6 +232,12 @@ pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
             label: String::new(),
             color: WHITE,
             at: [lo[0] - 0.32 * span, hi[1] + 0.05 * span],
+        });
+        // … and for the labels of points on the right edge.
+        markers.push(MapMarker {
+            label: String::new(),
+            color: WHITE,
+            at: [hi[0] + 0.1 * span, lo[1]],
         });
     }
     let title = format!(
@@ -486,7 +491,6 @@ where
 pub fn side(flight: &Flight, path: &Path) -> PlotResult<()> {
     let sc = &flight.scenario;
     let z_min = sc.vehicle.altitude_min_m;
-    let times = flight.samples.iter().map(|s| s.t);
     let t0 = flight.samples.first().map_or(0.0, |s| s.t);
     let t1 = flight
         .plans
@@ -554,7 +558,7 @@ pub fn side(flight: &Flight, path: &Path) -> PlotResult<()> {
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
     }
     c.draw_series(LineSeries::new(
-        times.zip(flight.samples.iter().map(|s| km(s.state[2]))),
+        decimated(flight).map(|s| (s.t, km(s.state[2]))),
         BLACK.stroke_width(3),
     ))
     .map_err(boxed)?
@@ -589,4 +593,15 @@ pub fn side(flight: &Flight, path: &Path) -> PlotResult<()> {
 
 fn dist(x: &[f64; 7], t: &[f64; 3]) -> f64 {
     ((x[0] - t[0]).powi(2) + (x[1] - t[1]).powi(2) + (x[2] - t[2]).powi(2)).sqrt()
+}
+
+/// The flown samples about one a second (and the last).
+fn decimated(flight: &Flight) -> impl Iterator<Item = &crate::tracker::TrackerSample> {
+    let n = flight.samples.len();
+    flight
+        .samples
+        .iter()
+        .enumerate()
+        .filter(move |(k, _)| k % 10 == 0 || k + 1 == n)
+        .map(|(_, s)| s)
 }
