@@ -169,6 +169,13 @@ fn main() -> ExitCode {
 fn apply(args: &FlyArgs, opts: &mut FlyOptions) -> Result<(), String> {
     opts.clock = args.clock;
     opts.progress = !args.quiet;
+    if let Some(t) = args.time_limit
+        && !t.is_finite()
+    {
+        return Err(format!(
+            "--time-limit must be a finite mission time, got {t}"
+        ));
+    }
     opts.time_limit_s = args.time_limit;
     if let Some(path) = &args.planner_config {
         opts.planner_config = ServiceConfig::load(path).map_err(|e| e.to_string())?;

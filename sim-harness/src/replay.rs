@@ -189,7 +189,12 @@ pub fn replay(log: &Path, timeout: Duration) -> Result<ReplayOutcome, ReplayErro
             planner_config,
             ..
         }) => (scenario.clone(), planner_config.clone()),
-        _ => unreachable!("flight_log::read checks the start record"),
+        _ => {
+            return Err(ReplayError::Log(flight_log::LogError::Version {
+                path: log.display().to_string(),
+                found: "no start record".into(),
+            }));
+        }
     };
     let mut config = ServiceConfig::from_toml(&config_text, "flight.log (planner_config)")?;
     config.vehicle_id = unique_vehicle_id("replay");

@@ -185,6 +185,11 @@ fn an_external_planner_is_flown_against_the_same_way() {
         still.is_none(),
         "the external planner was stopped: {still:?}"
     );
+    // Stopped cleanly (SIGTERM), so it releases its shared memory.
+    let pid = planner.0.as_ref().unwrap().id().to_string();
+    let _ = Command::new("kill").args(["-TERM", &pid]).status();
+    let o = planner.wait(Duration::from_secs(30));
+    assert!(o.status.success(), "the planner's exit: {:?}", o.status);
 }
 
 #[test]
