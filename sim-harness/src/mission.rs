@@ -260,7 +260,7 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
                 &vehicle,
                 &opts.out_dir.join("planner.log"),
             )?;
-            tracing::info!(pid = p.id(), vehicle = %vehicle, "planner started");
+            tracing::debug!(pid = p.id(), vehicle = %vehicle, "planner started");
             Some(p)
         }
         PlannerMode::External => None,
@@ -384,7 +384,7 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
                 let duration = plan.final_time_s - t0;
                 time_limit = t0 + (3.0 * duration).max(duration + 600.0);
             }
-            tracing::info!(
+            tracing::debug!(
                 plan_id = plan.plan_id,
                 trigger = plan.trigger().map_or("?", Trigger::name),
                 quality = plan.quality().map_or("?", Quality::name),
