@@ -938,10 +938,18 @@ impl MessageLoop {
             // Without a plan the status says `Degraded`; a new tasking tries again.
             Err(e) => warn!(trigger = ticket.trigger.name(), error = %e, "no plan made"),
         }
-        // Pending pop-ups that the new plan already avoids need no follow-up.
-        if self.has_plan && self.pending.set.only_popups() && !self.popups_touch(ticket.epoch) {
-            info!("pop-ups during the plan are clear of it: no follow-up");
-            self.pending = Pending::default();
+        // Threats that changed while the plan was computed are not in it: check each
+        // against the plan now current (a pop-up clear of the old plan may lie on the new
+        // one). Pending pop-ups that the new plan already avoids need no follow-up.
+        if self.has_plan && self.world.epoch > ticket.epoch {
+            let touch = self.popups_touch(ticket.epoch);
+            if self.pending.set.only_popups() && !touch {
+                info!("pop-ups during the plan are clear of it: no follow-up");
+                self.pending = Pending::default();
+            } else if touch && self.pending.set.is_empty() {
+                info!("a threat reported during the plan reaches it: re-plan");
+                self.raise(Trigger::PopUp);
+            }
         }
     }
 

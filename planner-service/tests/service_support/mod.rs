@@ -314,3 +314,81 @@ pub fn scenario_threats(sc: &Scenario) -> Vec<ThreatReport> {
         })
         .collect()
 }
+
+/// The message loop driven pass by pass from the test thread (no WaitSet): the test
+/// decides when inputs are drained relative to the solve thread's work.
+pub struct Driven {
+    pub ml: wingman_planner::service::MessageLoop,
+    pub h: FakeHarness,
+}
+
+impl Driven {
+    /// A message loop with `config` and its fake harness.
+    pub fn new(config: ServiceConfig) -> Driven {
+        wingman_planner::logging::init();
+        let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
+        let v = config.vehicle_id.clone();
+        let options = RunOptions {
+            config,
+            clock,
+            handle_signals: false,
+            shutdown: Shutdown::new(),
+        };
+        let ml = wingman_planner::service::MessageLoop::new(&options).expect("message loop");
+        let h = FakeHarness::new(&v);
+        Driven { ml, h }
+    }
+
+    /// One pass of the loop (status published), then the harness takes what came.
+    pub fn pass(&mut self) {
+        self.ml.process(false);
+        self.h.poll();
+    }
+
+    /// Passes until nothing is planning or waiting for the compute gate (at most 120 s).
+    pub fn settle(&mut self) {
+        let start = Instant::now();
+        loop {
+            self.pass();
+            if self.ml.status_message().state() != Some(PlannerState::Planning) {
+                return;
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(120),
+                "still planning after 120 s: {:?}",
+                self.ml.status_message()
+            );
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+
+    /// The status the loop would publish now.
+    pub fn status(&self) -> PlannerStatus {
+        self.ml.status_message()
+    }
+
+    /// Sends the threats known at take-off and the tasking of scenario `name` at mission
+    /// time 0, and settles on the first plan.
+    pub fn first_plan(&mut self, name: &str) -> Scenario {
+        let sc = wingman_planner::scenario::bundled(name).unwrap().unwrap();
+        self.h.set_time(0.0);
+        for t in scenario_threats(&sc) {
+            self.h.send_threat(t);
+        }
+        self.h.send_tasking(tasking_from(&sc, 1));
+        self.settle();
+        assert_eq!(self.status().plans_made, 1, "no first plan");
+        assert_eq!(self.h.plans.len(), 1);
+        sc
+    }
+}
+
+/// An ownship state of a 2-D mission at `t` flying plan `plan_id`.
+pub fn ownship_2d(t: f64, plan_id: u64, state: [f64; 3]) -> OwnshipState {
+    let mut o = OwnshipState::zeroed();
+    o.time_s = t;
+    o.model = Model::TwoD.to_wire();
+    o.plan_id = plan_id;
+    o.state[..3].copy_from_slice(&state);
+    o
+}

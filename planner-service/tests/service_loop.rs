@@ -1,0 +1,58 @@
+//! The message loop driven pass by pass from the test (`service_support::Driven`), so that
+//! a test decides which inputs arrive while a plan is in flight. Each test names the
+//! protection it checks; each fails without it.
+
+mod service_support;
+
+use std::time::Duration;
+
+use service_support::*;
+use wingman_interfaces::*;
+use wingman_planner::service::export::state_at;
+
+/// B1: a pop-up that arrives while a plan is in flight, clear of the old plan but on the
+/// new one, re-plans once the new plan is taken (`on_result` checks the threats newer than
+/// the plan's snapshot against the plan now current).
+#[test]
+fn a_popup_during_a_plan_is_checked_against_the_new_plan() {
+    let mut d = Driven::new(test_config(&vehicle("popup-in-flight")));
+    let sc = d.first_plan("2d-min-time-avoidable");
+    // A new tasking: the target moves 20 km south of the start, far from the old plan.
+    let target = [40000.0, -20000.0, 0.0];
+    let mut t = tasking_from(&sc, 2);
+    t.targets_m[0] = target;
+    std::thread::sleep(Duration::from_millis(300)); // past the gate's spacing
+    d.h.set_time(5.0);
+    d.h.send_tasking(t);
+    d.pass();
+    assert_eq!(d.status().state(), Some(PlannerState::Planning));
+    // A pop-up on the new target, reported while that plan is computed.
+    d.h.send_threat(static_threat(
+        80,
+        [target[0], target[1], 0.0],
+        [2000.0, 2000.0, 0.0],
+    ));
+    d.pass();
+    let s = d.status();
+    assert_eq!(
+        (s.plans_made, s.popups_clear),
+        (1, 1),
+        "precondition: assessed against the old plan while the new one was in flight"
+    );
+    d.settle();
+    let s = d.status();
+    assert_eq!(
+        s.plans_made, 3,
+        "the tasking's plan, then a re-plan for the pop-up on it"
+    );
+    let last = d.h.plans.last().unwrap();
+    assert_eq!(last.trigger(), Some(Trigger::PopUp));
+    assert_eq!(d.h.plans[1].trigger(), Some(Trigger::Tasking));
+    // The tasking's plan indeed went through the pop-up (it visits the target).
+    let p = &d.h.plans[1];
+    let through = p.samples().iter().any(|s| {
+        (s.state[0] - target[0]).hypot(s.state[1] - target[1]) < 2000.0
+    });
+    assert!(through, "the tasking's plan visits the target");
+    let _ = state_at;
+}
