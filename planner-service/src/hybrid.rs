@@ -51,6 +51,9 @@ pub struct PlannerSettings {
     pub mesh: MeshSettings,
     pub transcription: TranscriptionSettings,
     pub nlp: NlpSettings,
+    /// The NLP settings of the ranking solves on the coarse mesh (they only have to tell
+    /// the basins apart: looser tolerances).
+    pub ranking_nlp: NlpSettings,
     pub refine: RefineSettings,
     /// Refinement rounds after the first NLP solve.
     pub refine_rounds: usize,
@@ -77,6 +80,10 @@ impl Default for PlannerSettings {
             mesh: MeshSettings::default(),
             transcription: TranscriptionSettings::default(),
             nlp: NlpSettings {
+                feral_static_pivoting: true,
+                ..NlpSettings::default()
+            },
+            ranking_nlp: NlpSettings {
                 feral_static_pivoting: true,
                 ..NlpSettings::default()
             },
@@ -130,6 +137,8 @@ pub struct NlpReport {
     pub intervals: Vec<usize>,
     /// Objective of the last accepted solve (its own quadrature).
     pub objective: f64,
+    /// Dense cost of each start after its ranking solve (`NaN`: no feasible result).
+    pub ranking: Vec<f64>,
 }
 
 /// The planner's answer.
@@ -169,6 +178,7 @@ fn solve_on_mesh(
     mesh: &Mesh,
     guess: &Trajectory,
     settings: &PlannerSettings,
+    nlp_settings: &NlpSettings,
     refined: bool,
     feasibility_tol: f64,
     deadline: Deadline<'static>,
@@ -182,10 +192,10 @@ fn solve_on_mesh(
     tr.initial_point(guess, &mut x);
     let j0 = tr.objective(&x);
     tr.obj_scale = 1.0 / j0.abs().max(1e-3);
-    let mut nlp = settings.nlp.clone();
+    let mut nlp = nlp_settings.clone();
     if refined {
         // A refined mesh starts from the previous solution: a small barrier keeps it.
-        nlp.mu_init = Some(settings.nlp.refine_mu_init);
+        nlp.mu_init = Some(nlp_settings.refine_mu_init);
     }
     let (tr, out) = solve(
         tr,
@@ -217,30 +227,45 @@ fn solve_on_mesh(
 type SolveResult = Result<(Option<Solved>, usize, NlpStatus), PlanError>;
 
 /// Runs `job(i)` for `i in 0..n` on up to `threads` threads; results in index order.
+/// Each thread takes the next unstarted job when it finishes one (solves differ in length
+/// by a factor of three), so the threads stay busy; which thread ran a job does not change
+/// its result.
 fn in_parallel(
     n: usize,
     threads: usize,
     job: impl Fn(usize) -> SolveResult + Sync,
 ) -> Vec<SolveResult> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
     let threads = threads.clamp(1, n.max(1));
+    let next = AtomicUsize::new(0);
+    let work = || {
+        let mut done = Vec::new();
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            if i >= n {
+                break done;
+            }
+            done.push((i, job(i)));
+        }
+    };
     std::thread::scope(|scope| {
-        let job = &job;
-        let workers: Vec<_> = (0..threads)
-            .map(|w| {
-                scope.spawn(move || {
-                    (w..n)
-                        .step_by(threads)
-                        .map(|i| (i, job(i)))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        let mut all: Vec<(usize, SolveResult)> = workers
+        let work = &work;
+        let helpers: Vec<_> = (1..threads).map(|_| scope.spawn(work)).collect();
+        // The calling thread works too.
+        let mut slots: Vec<Option<SolveResult>> = (0..n).map(|_| None).collect();
+        let mine = work();
+        // A thread that panicked (a solver bug) loses its jobs: they count as failed
+        // starts, and the plan goes on with the others.
+        let theirs = helpers
             .into_iter()
-            .flat_map(|h| h.join().unwrap_or_default())
-            .collect();
-        all.sort_by_key(|(i, _)| *i);
-        all.into_iter().map(|(_, r)| r).collect()
+            .flat_map(|h| h.join().unwrap_or_default());
+        for (i, r) in mine.into_iter().chain(theirs) {
+            slots[i] = Some(r);
+        }
+        slots
+            .into_iter()
+            .map(|r| r.unwrap_or(Ok((None, 0, NlpStatus::NumericalError))))
+            .collect()
     })
 }
 
@@ -284,6 +309,7 @@ impl Planner {
             iterations: Vec::new(),
             intervals: Vec::new(),
             objective: f64::NAN,
+            ranking: Vec::new(),
         };
         // Starts from distinct basins, solved side by side on the first mesh.
         // The swarm's workspace holds this problem's seeds: no need to build them again.
@@ -314,6 +340,7 @@ impl Planner {
                 &coarse[i],
                 &starts[i],
                 settings,
+                &settings.ranking_nlp,
                 false,
                 settings.ranking_feasibility_tol,
                 deadline,
@@ -334,7 +361,11 @@ impl Planner {
                 export(&s.tr, &s.x, &reference, &mut tr);
                 // Rank by the path's cost re-evaluated densely: the coarse mesh's own
                 // quadrature misjudges sharp exposure transitions by percents.
-                order.push((trajectory_cost(problem, &tr), i, tr));
+                let cost = trajectory_cost(problem, &tr);
+                report.ranking.push(cost);
+                order.push((cost, i, tr));
+            } else {
+                report.ranking.push(f64::NAN);
             }
         }
         // Lowest objective first; ties go to the earlier start (deterministic).
@@ -362,6 +393,7 @@ impl Planner {
                 &fine[i],
                 &order[i].2,
                 settings,
+                &settings.nlp,
                 true,
                 settings.nlp.feasibility_tol,
                 deadline,
@@ -399,6 +431,7 @@ impl Planner {
                 &next,
                 &guess,
                 settings,
+                &settings.nlp,
                 true,
                 settings.nlp.feasibility_tol,
                 deadline,
