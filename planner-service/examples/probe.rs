@@ -57,6 +57,15 @@ fn main() {
     if let Some(v) = env("PROBE_THREADS") {
         s.threads = v;
     }
+    if let Some(v) = env::<u8>("PROBE_WARM") {
+        s.warm_mesh_changes = v != 0;
+    }
+    if let Some(v) = env("PROBE_WARM_MU") {
+        s.nlp.warm_start_mu_init = v;
+    }
+    if let Some(v) = env("PROBE_WARM_PUSH") {
+        s.nlp.warm_start_push = v;
+    }
     if let Ok(extra) = std::env::var("PROBE_NLP") {
         for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
             if let Some((k, v)) = kv.split_once('=') {

@@ -71,6 +71,9 @@ pub struct PlannerSettings {
     pub ranking_feasibility_tol: f64,
     /// How many of the best-ranked starts are solved again on the working mesh.
     pub finalists: usize,
+    /// Start the solves on the working and the refined meshes primal-dual from the
+    /// previous mesh's solution (multipliers carried over, see `collocation::warm`).
+    pub warm_mesh_changes: bool,
 }
 
 impl Default for PlannerSettings {
@@ -100,6 +103,7 @@ impl Default for PlannerSettings {
             },
             ranking_feasibility_tol: 1e-4,
             finalists: 2,
+            warm_mesh_changes: true,
         }
     }
 }
@@ -170,6 +174,8 @@ struct Solved {
     objective: f64,
     iterations: usize,
     status: NlpStatus,
+    /// The converged primal-dual solution, for a warm start on the next mesh.
+    warm: Option<PrimalDual>,
 }
 
 /// Solves `problem` on `mesh` from `guess`; `None` if the result is not feasible.
@@ -181,6 +187,7 @@ fn solve_on_mesh(
     nlp_settings: &NlpSettings,
     refined: bool,
     feasibility_tol: f64,
+    warm_from: Option<(&Transcription, &PrimalDual)>,
     deadline: Deadline<'static>,
 ) -> Result<(Option<Solved>, usize, NlpStatus), PlanError> {
     if deadline.expired() {
@@ -197,16 +204,13 @@ fn solve_on_mesh(
         // A refined mesh starts from the previous solution: a small barrier keeps it.
         nlp.mu_init = Some(nlp_settings.refine_mu_init);
     }
-    let (tr, out) = solve(
-        tr,
-        PrimalDual {
-            x,
-            ..PrimalDual::default()
-        },
-        false,
-        &nlp,
-        deadline,
-    )?;
+    let mut start = PrimalDual::default();
+    let warm = match warm_from {
+        Some((from, duals)) => crate::collocation::warm::transfer(from, duals, &tr, &mut start),
+        None => false,
+    };
+    start.x = x;
+    let (tr, out) = solve(tr, start, warm, &nlp, deadline)?;
     let feasible = out.violation <= feasibility_tol;
     let quality = match (out.status, feasible) {
         (NlpStatus::Converged, true) => Some(Quality::Optimal),
@@ -220,6 +224,7 @@ fn solve_on_mesh(
         objective: out.objective,
         iterations: out.iterations,
         status: out.status,
+        warm: out.warm,
     });
     Ok((solved, out.iterations, out.status))
 }
@@ -343,6 +348,7 @@ impl Planner {
                 &settings.ranking_nlp,
                 false,
                 settings.ranking_feasibility_tol,
+                None,
                 deadline,
             )
         });
@@ -352,10 +358,12 @@ impl Planner {
             max_step_s: settings.export.max_step_s / 2.0,
             ..settings.export
         };
+        let mut coarse_solved: Vec<Option<Solved>> = Vec::with_capacity(ranked.len());
         for (i, r) in ranked.into_iter().enumerate() {
             let (solved, iterations, status) = r?;
             report.iterations.push(iterations);
             report.status = Some(status);
+            coarse_solved.push(None);
             if let Some(s) = solved {
                 let mut tr = Trajectory::default();
                 export(&s.tr, &s.x, &reference, &mut tr);
@@ -364,6 +372,7 @@ impl Planner {
                 let cost = trajectory_cost(problem, &tr);
                 report.ranking.push(cost);
                 order.push((cost, i, tr));
+                coarse_solved[i] = Some(s);
             } else {
                 report.ranking.push(f64::NAN);
             }
@@ -387,6 +396,7 @@ impl Planner {
                 )
             })
             .collect();
+        let warm = settings.warm_mesh_changes;
         let finals = in_parallel(order.len(), settings.threads, |i| {
             solve_on_mesh(
                 problem,
@@ -396,9 +406,13 @@ impl Planner {
                 &settings.nlp,
                 true,
                 settings.nlp.feasibility_tol,
+                coarse_solved
+                    .get(order[i].1)
+                    .and_then(|s| warm_start_of(s, warm)),
                 deadline,
             )
         });
+        drop(coarse_solved);
         let mut accepted: Option<Solved> = None;
         let mut mesh = fine[0].clone();
         for (i, r) in finals.into_iter().enumerate() {
@@ -434,6 +448,7 @@ impl Planner {
                 &settings.nlp,
                 true,
                 settings.nlp.feasibility_tol,
+                warm_start_of(&accepted, warm),
                 deadline,
             )?;
             report.iterations.push(iterations);
@@ -487,6 +502,12 @@ impl Planner {
             times,
         })
     }
+}
+
+/// The transcription and primal-dual solution of `solved` to warm-start the next mesh from.
+fn warm_start_of(solved: &Option<Solved>, enabled: bool) -> Option<(&Transcription, &PrimalDual)> {
+    let s = solved.as_ref().filter(|_| enabled)?;
+    s.warm.as_ref().map(|w| (&s.tr, w))
 }
 
 /// Phase durations of a trajectory (at least one second each).

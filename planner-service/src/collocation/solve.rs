@@ -75,7 +75,7 @@ impl Default for NlpSettings {
             feasibility_tol: 1e-6,
             mu_strategy: "monotone",
             warm_start_push: 1e-6,
-            warm_start_mu_init: 1e-5,
+            warm_start_mu_init: 1e-6,
             print_level: 0,
             feral_refine: false,
             feral_ordering: "amf",
