@@ -178,18 +178,38 @@ struct Solved {
     warm: Option<PrimalDual>,
 }
 
-/// Solves `problem` on `mesh` from `guess`; `None` if the result is not feasible.
-fn solve_on_mesh(
-    problem: &Problem,
-    mesh: &Mesh,
-    guess: &Trajectory,
-    settings: &PlannerSettings,
-    nlp_settings: &NlpSettings,
+/// One NLP solve of the plan: which mesh, from where, with which settings.
+struct MeshSolve<'a> {
+    problem: &'a Problem,
+    mesh: &'a Mesh,
+    /// The primal starting point (interpolated onto the mesh).
+    guess: &'a Trajectory,
+    settings: &'a PlannerSettings,
+    nlp_settings: &'a NlpSettings,
+    /// The guess is a solution on another mesh (a small initial barrier keeps it).
     refined: bool,
+    /// Largest scaled violation of a result that is accepted.
     feasibility_tol: f64,
-    warm_from: Option<(&Transcription, &PrimalDual)>,
+    /// The previous mesh's transcription and primal-dual solution, to start from.
+    warm_from: Option<(&'a Transcription, &'a PrimalDual)>,
+}
+
+/// Solves `job.problem` on `job.mesh` from `job.guess`; `None` if the result is not
+/// feasible.
+fn solve_on_mesh(
+    job: MeshSolve<'_>,
     deadline: Deadline<'static>,
 ) -> Result<(Option<Solved>, usize, NlpStatus), PlanError> {
+    let MeshSolve {
+        problem,
+        mesh,
+        guess,
+        settings,
+        nlp_settings,
+        refined,
+        feasibility_tol,
+        warm_from,
+    } = job;
     if deadline.expired() {
         // No time: do not even build the NLP (the caller returns what it has).
         return Ok((None, 0, NlpStatus::MaxTime));
@@ -341,14 +361,16 @@ impl Planner {
             .collect();
         let ranked = in_parallel(starts.len(), settings.threads, |i| {
             solve_on_mesh(
-                problem,
-                &coarse[i],
-                &starts[i],
-                settings,
-                &settings.ranking_nlp,
-                false,
-                settings.ranking_feasibility_tol,
-                None,
+                MeshSolve {
+                    problem,
+                    mesh: &coarse[i],
+                    guess: &starts[i],
+                    settings,
+                    nlp_settings: &settings.ranking_nlp,
+                    refined: false,
+                    feasibility_tol: settings.ranking_feasibility_tol,
+                    warm_from: None,
+                },
                 deadline,
             )
         });
@@ -399,16 +421,18 @@ impl Planner {
         let warm = settings.warm_mesh_changes;
         let finals = in_parallel(order.len(), settings.threads, |i| {
             solve_on_mesh(
-                problem,
-                &fine[i],
-                &order[i].2,
-                settings,
-                &settings.nlp,
-                true,
-                settings.nlp.feasibility_tol,
-                coarse_solved
-                    .get(order[i].1)
-                    .and_then(|s| warm_start_of(s, warm)),
+                MeshSolve {
+                    problem,
+                    mesh: &fine[i],
+                    guess: &order[i].2,
+                    settings,
+                    nlp_settings: &settings.nlp,
+                    refined: true,
+                    feasibility_tol: settings.nlp.feasibility_tol,
+                    warm_from: coarse_solved
+                        .get(order[i].1)
+                        .and_then(|s| warm_start_of(s, warm)),
+                },
                 deadline,
             )
         });
@@ -441,14 +465,16 @@ impl Planner {
             };
             export(&current.tr, &current.x, &reference, &mut guess);
             let (solved, iterations, status) = solve_on_mesh(
-                problem,
-                &next,
-                &guess,
-                settings,
-                &settings.nlp,
-                true,
-                settings.nlp.feasibility_tol,
-                warm_start_of(&accepted, warm),
+                MeshSolve {
+                    problem,
+                    mesh: &next,
+                    guess: &guess,
+                    settings,
+                    nlp_settings: &settings.nlp,
+                    refined: true,
+                    feasibility_tol: settings.nlp.feasibility_tol,
+                    warm_from: warm_start_of(&accepted, warm),
+                },
                 deadline,
             )?;
             report.iterations.push(iterations);
