@@ -7,6 +7,7 @@ pub mod mesh;
 pub mod refine;
 pub mod solve;
 pub mod transcription;
+pub mod warm;
 
 pub use export::{ExportSettings, export, fly};
 pub use lgr::Lgr;

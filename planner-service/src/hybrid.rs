@@ -51,6 +51,9 @@ pub struct PlannerSettings {
     pub mesh: MeshSettings,
     pub transcription: TranscriptionSettings,
     pub nlp: NlpSettings,
+    /// The NLP settings of the ranking solves on the coarse mesh (they only have to tell
+    /// the basins apart: looser tolerances).
+    pub ranking_nlp: NlpSettings,
     pub refine: RefineSettings,
     /// Refinement rounds after the first NLP solve.
     pub refine_rounds: usize,
@@ -68,6 +71,9 @@ pub struct PlannerSettings {
     pub ranking_feasibility_tol: f64,
     /// How many of the best-ranked starts are solved again on the working mesh.
     pub finalists: usize,
+    /// Start the solves on the working and the refined meshes primal-dual from the
+    /// previous mesh's solution (multipliers carried over, see `collocation::warm`).
+    pub warm_mesh_changes: bool,
 }
 
 impl Default for PlannerSettings {
@@ -77,6 +83,10 @@ impl Default for PlannerSettings {
             mesh: MeshSettings::default(),
             transcription: TranscriptionSettings::default(),
             nlp: NlpSettings {
+                feral_static_pivoting: true,
+                ..NlpSettings::default()
+            },
+            ranking_nlp: NlpSettings {
                 feral_static_pivoting: true,
                 ..NlpSettings::default()
             },
@@ -93,6 +103,7 @@ impl Default for PlannerSettings {
             },
             ranking_feasibility_tol: 1e-4,
             finalists: 2,
+            warm_mesh_changes: true,
         }
     }
 }
@@ -130,6 +141,8 @@ pub struct NlpReport {
     pub intervals: Vec<usize>,
     /// Objective of the last accepted solve (its own quadrature).
     pub objective: f64,
+    /// Dense cost of each start after its ranking solve (`NaN`: no feasible result).
+    pub ranking: Vec<f64>,
 }
 
 /// The planner's answer.
@@ -161,18 +174,42 @@ struct Solved {
     objective: f64,
     iterations: usize,
     status: NlpStatus,
+    /// The converged primal-dual solution, for a warm start on the next mesh.
+    warm: Option<PrimalDual>,
 }
 
-/// Solves `problem` on `mesh` from `guess`; `None` if the result is not feasible.
-fn solve_on_mesh(
-    problem: &Problem,
-    mesh: &Mesh,
-    guess: &Trajectory,
-    settings: &PlannerSettings,
+/// One NLP solve of the plan: which mesh, from where, with which settings.
+struct MeshSolve<'a> {
+    problem: &'a Problem,
+    mesh: &'a Mesh,
+    /// The primal starting point (interpolated onto the mesh).
+    guess: &'a Trajectory,
+    settings: &'a PlannerSettings,
+    nlp_settings: &'a NlpSettings,
+    /// The guess is a solution on another mesh (a small initial barrier keeps it).
     refined: bool,
+    /// Largest scaled violation of a result that is accepted.
     feasibility_tol: f64,
+    /// The previous mesh's transcription and primal-dual solution, to start from.
+    warm_from: Option<(&'a Transcription, &'a PrimalDual)>,
+}
+
+/// Solves `job.problem` on `job.mesh` from `job.guess`; `None` if the result is not
+/// feasible.
+fn solve_on_mesh(
+    job: MeshSolve<'_>,
     deadline: Deadline<'static>,
 ) -> Result<(Option<Solved>, usize, NlpStatus), PlanError> {
+    let MeshSolve {
+        problem,
+        mesh,
+        guess,
+        settings,
+        nlp_settings,
+        refined,
+        feasibility_tol,
+        warm_from,
+    } = job;
     if deadline.expired() {
         // No time: do not even build the NLP (the caller returns what it has).
         return Ok((None, 0, NlpStatus::MaxTime));
@@ -182,21 +219,18 @@ fn solve_on_mesh(
     tr.initial_point(guess, &mut x);
     let j0 = tr.objective(&x);
     tr.obj_scale = 1.0 / j0.abs().max(1e-3);
-    let mut nlp = settings.nlp.clone();
+    let mut nlp = nlp_settings.clone();
     if refined {
         // A refined mesh starts from the previous solution: a small barrier keeps it.
-        nlp.mu_init = Some(settings.nlp.refine_mu_init);
+        nlp.mu_init = Some(nlp_settings.refine_mu_init);
     }
-    let (tr, out) = solve(
-        tr,
-        PrimalDual {
-            x,
-            ..PrimalDual::default()
-        },
-        false,
-        &nlp,
-        deadline,
-    )?;
+    let mut start = PrimalDual::default();
+    let warm = match warm_from {
+        Some((from, duals)) => crate::collocation::warm::transfer(from, duals, &tr, &mut start),
+        None => false,
+    };
+    start.x = x;
+    let (tr, out) = solve(tr, start, warm, &nlp, deadline)?;
     let feasible = out.violation <= feasibility_tol;
     let quality = match (out.status, feasible) {
         (NlpStatus::Converged, true) => Some(Quality::Optimal),
@@ -210,6 +244,7 @@ fn solve_on_mesh(
         objective: out.objective,
         iterations: out.iterations,
         status: out.status,
+        warm: out.warm,
     });
     Ok((solved, out.iterations, out.status))
 }
@@ -217,30 +252,45 @@ fn solve_on_mesh(
 type SolveResult = Result<(Option<Solved>, usize, NlpStatus), PlanError>;
 
 /// Runs `job(i)` for `i in 0..n` on up to `threads` threads; results in index order.
+/// Each thread takes the next unstarted job when it finishes one (solves differ in length
+/// by a factor of three), so the threads stay busy; which thread ran a job does not change
+/// its result.
 fn in_parallel(
     n: usize,
     threads: usize,
     job: impl Fn(usize) -> SolveResult + Sync,
 ) -> Vec<SolveResult> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
     let threads = threads.clamp(1, n.max(1));
+    let next = AtomicUsize::new(0);
+    let work = || {
+        let mut done = Vec::new();
+        loop {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            if i >= n {
+                break done;
+            }
+            done.push((i, job(i)));
+        }
+    };
     std::thread::scope(|scope| {
-        let job = &job;
-        let workers: Vec<_> = (0..threads)
-            .map(|w| {
-                scope.spawn(move || {
-                    (w..n)
-                        .step_by(threads)
-                        .map(|i| (i, job(i)))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        let mut all: Vec<(usize, SolveResult)> = workers
+        let work = &work;
+        let helpers: Vec<_> = (1..threads).map(|_| scope.spawn(work)).collect();
+        // The calling thread works too.
+        let mut slots: Vec<Option<SolveResult>> = (0..n).map(|_| None).collect();
+        let mine = work();
+        // A thread that panicked (a solver bug) loses its jobs: they count as failed
+        // starts, and the plan goes on with the others.
+        let theirs = helpers
             .into_iter()
-            .flat_map(|h| h.join().unwrap_or_default())
-            .collect();
-        all.sort_by_key(|(i, _)| *i);
-        all.into_iter().map(|(_, r)| r).collect()
+            .flat_map(|h| h.join().unwrap_or_default());
+        for (i, r) in mine.into_iter().chain(theirs) {
+            slots[i] = Some(r);
+        }
+        slots
+            .into_iter()
+            .map(|r| r.unwrap_or(Ok((None, 0, NlpStatus::NumericalError))))
+            .collect()
     })
 }
 
@@ -284,6 +334,7 @@ impl Planner {
             iterations: Vec::new(),
             intervals: Vec::new(),
             objective: f64::NAN,
+            ranking: Vec::new(),
         };
         // Starts from distinct basins, solved side by side on the first mesh.
         // The swarm's workspace holds this problem's seeds: no need to build them again.
@@ -310,12 +361,16 @@ impl Planner {
             .collect();
         let ranked = in_parallel(starts.len(), settings.threads, |i| {
             solve_on_mesh(
-                problem,
-                &coarse[i],
-                &starts[i],
-                settings,
-                false,
-                settings.ranking_feasibility_tol,
+                MeshSolve {
+                    problem,
+                    mesh: &coarse[i],
+                    guess: &starts[i],
+                    settings,
+                    nlp_settings: &settings.ranking_nlp,
+                    refined: false,
+                    feasibility_tol: settings.ranking_feasibility_tol,
+                    warm_from: None,
+                },
                 deadline,
             )
         });
@@ -325,16 +380,23 @@ impl Planner {
             max_step_s: settings.export.max_step_s / 2.0,
             ..settings.export
         };
+        let mut coarse_solved: Vec<Option<Solved>> = Vec::with_capacity(ranked.len());
         for (i, r) in ranked.into_iter().enumerate() {
             let (solved, iterations, status) = r?;
             report.iterations.push(iterations);
             report.status = Some(status);
+            coarse_solved.push(None);
             if let Some(s) = solved {
                 let mut tr = Trajectory::default();
                 export(&s.tr, &s.x, &reference, &mut tr);
                 // Rank by the path's cost re-evaluated densely: the coarse mesh's own
                 // quadrature misjudges sharp exposure transitions by percents.
-                order.push((trajectory_cost(problem, &tr), i, tr));
+                let cost = trajectory_cost(problem, &tr);
+                report.ranking.push(cost);
+                order.push((cost, i, tr));
+                coarse_solved[i] = Some(s);
+            } else {
+                report.ranking.push(f64::NAN);
             }
         }
         // Lowest objective first; ties go to the earlier start (deterministic).
@@ -356,17 +418,25 @@ impl Planner {
                 )
             })
             .collect();
+        let warm = settings.warm_mesh_changes;
         let finals = in_parallel(order.len(), settings.threads, |i| {
             solve_on_mesh(
-                problem,
-                &fine[i],
-                &order[i].2,
-                settings,
-                true,
-                settings.nlp.feasibility_tol,
+                MeshSolve {
+                    problem,
+                    mesh: &fine[i],
+                    guess: &order[i].2,
+                    settings,
+                    nlp_settings: &settings.nlp,
+                    refined: true,
+                    feasibility_tol: settings.nlp.feasibility_tol,
+                    warm_from: coarse_solved
+                        .get(order[i].1)
+                        .and_then(|s| warm_start_of(s, warm)),
+                },
                 deadline,
             )
         });
+        drop(coarse_solved);
         let mut accepted: Option<Solved> = None;
         let mut mesh = fine[0].clone();
         for (i, r) in finals.into_iter().enumerate() {
@@ -395,12 +465,16 @@ impl Planner {
             };
             export(&current.tr, &current.x, &reference, &mut guess);
             let (solved, iterations, status) = solve_on_mesh(
-                problem,
-                &next,
-                &guess,
-                settings,
-                true,
-                settings.nlp.feasibility_tol,
+                MeshSolve {
+                    problem,
+                    mesh: &next,
+                    guess: &guess,
+                    settings,
+                    nlp_settings: &settings.nlp,
+                    refined: true,
+                    feasibility_tol: settings.nlp.feasibility_tol,
+                    warm_from: warm_start_of(&accepted, warm),
+                },
                 deadline,
             )?;
             report.iterations.push(iterations);
@@ -454,6 +528,12 @@ impl Planner {
             times,
         })
     }
+}
+
+/// The transcription and primal-dual solution of `solved` to warm-start the next mesh from.
+fn warm_start_of(solved: &Option<Solved>, enabled: bool) -> Option<(&Transcription, &PrimalDual)> {
+    let s = solved.as_ref().filter(|_| enabled)?;
+    s.warm.as_ref().map(|w| (&s.tr, w))
 }
 
 /// Phase durations of a trajectory (at least one second each).

@@ -60,6 +60,9 @@ pub struct NlpSettings {
     pub mu_init: Option<f64>,
     /// Initial barrier parameter when starting from a previous solution on a refined mesh.
     pub refine_mu_init: f64,
+    /// Further solver options by name (`name=value`: a number, an integer or a word), set
+    /// after the ones above; for experiments and expert tuning.
+    pub extra: Vec<(String, String)>,
 }
 
 impl Default for NlpSettings {
@@ -72,7 +75,7 @@ impl Default for NlpSettings {
             feasibility_tol: 1e-6,
             mu_strategy: "monotone",
             warm_start_push: 1e-6,
-            warm_start_mu_init: 1e-5,
+            warm_start_mu_init: 1e-6,
             print_level: 0,
             feral_refine: false,
             feral_ordering: "amf",
@@ -82,6 +85,7 @@ impl Default for NlpSettings {
             feral_pivtol: None,
             mu_init: None,
             refine_mu_init: 1e-3,
+            extra: Vec::new(),
         }
     }
 }
@@ -387,6 +391,23 @@ fn application(
             num(o, name, settings.warm_start_push)?;
         }
         num(o, "mu_init", settings.warm_start_mu_init)?;
+    }
+    for (name, value) in &settings.extra {
+        let refused = |e: String| OptionError {
+            name: "extra",
+            reason: format!("{name}={value}: {e}"),
+        };
+        let done = if let Ok(i) = value.parse::<i32>() {
+            o.set_integer_value(name, i, true, false).is_ok()
+                || o.set_numeric_value(name, f64::from(i), true, false).is_ok()
+        } else if let Ok(v) = value.parse::<f64>() {
+            o.set_numeric_value(name, v, true, false).is_ok()
+        } else {
+            o.set_string_value(name, value, true, false).is_ok()
+        };
+        if !done {
+            return Err(refused("refused".into()));
+        }
     }
     install_restoration(&mut app);
     Ok(app)

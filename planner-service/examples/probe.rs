@@ -1,0 +1,156 @@
+//! Tuning probe of the hybrid planner: plans bundled scenarios with the default settings,
+//! overridden by environment variables, and prints per scenario the median plan time, its
+//! split, the NLP iterations and the planner's own cost against the reference optimum.
+//!
+//! `cargo run --release -p wingman-planner --example probe -- [NAME-FILTER] [RUNS]`
+//!
+//! Overrides: `PROBE_STARTS`, `PROBE_FINALISTS`, `PROBE_ROUNDS`, `PROBE_RANK_PTS`,
+//! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`,
+//! `PROBE_NLP="name=value;name=value"` (extra solver options).
+
+use std::time::Duration;
+
+use wingman_planner::clock::{Deadline, MonotonicClock};
+use wingman_planner::hybrid::{Planner, PlannerSettings};
+use wingman_planner::problem::Problem;
+use wingman_planner::scenario::{BUNDLED, bundled};
+
+fn env<T: std::str::FromStr>(name: &str) -> Option<T> {
+    std::env::var(name).ok().and_then(|v| v.parse().ok())
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let filter = args.get(1).cloned().unwrap_or_default();
+    let runs: u64 = args.get(2).and_then(|v| v.parse().ok()).unwrap_or(3);
+    let refs: toml::Table = toml::from_str(
+        &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../tools/judge/costs.toml"
+        ))
+        .unwrap_or_default(),
+    )
+    .unwrap_or_default();
+    let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
+    let mut s = PlannerSettings::default();
+    if let Some(v) = env("PROBE_STARTS") {
+        s.starts = v;
+    }
+    if let Some(v) = env("PROBE_FINALISTS") {
+        s.finalists = v;
+    }
+    if let Some(v) = env("PROBE_ROUNDS") {
+        s.refine_rounds = v;
+    }
+    if let Some(v) = env("PROBE_RANK_PTS") {
+        s.ranking_mesh.points = v;
+    }
+    if let Some(v) = env("PROBE_RANK_S") {
+        s.ranking_mesh.interval_s = v;
+    }
+    if let Some(v) = env("PROBE_MESH_PTS") {
+        s.mesh.points = v;
+    }
+    if let Some(v) = env("PROBE_MESH_S") {
+        s.mesh.interval_s = v;
+    }
+    if let Some(v) = env("PROBE_THREADS") {
+        s.threads = v;
+    }
+    if let Some(v) = env::<u8>("PROBE_WARM") {
+        s.warm_mesh_changes = v != 0;
+    }
+    if let Some(v) = env("PROBE_WARM_MU") {
+        s.nlp.warm_start_mu_init = v;
+    }
+    if let Some(v) = env("PROBE_WARM_PUSH") {
+        s.nlp.warm_start_push = v;
+    }
+    if let Ok(extra) = std::env::var("PROBE_NLP") {
+        for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
+            if let Some((k, v)) = kv.split_once('=') {
+                s.nlp.extra.push((k.to_string(), v.to_string()));
+                s.ranking_nlp.extra.push((k.to_string(), v.to_string()));
+            }
+        }
+    }
+    if let Ok(extra) = std::env::var("PROBE_RANK_NLP") {
+        for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
+            if let Some((k, v)) = kv.split_once('=') {
+                s.ranking_nlp.extra.push((k.to_string(), v.to_string()));
+            }
+        }
+    }
+    let mut worst = 0.0f64;
+    for (name, _) in BUNDLED {
+        if !name.contains(filter.as_str()) {
+            continue;
+        }
+        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+        let reference = refs
+            .get(*name)
+            .and_then(|t| t.get("cost"))
+            .and_then(|c| c.as_float())
+            .unwrap_or(f64::NAN);
+        let mut times = Vec::new();
+        let mut line = String::new();
+        let mut ratios = Vec::new();
+        for seed in 1..=runs {
+            let st = PlannerSettings {
+                swarm: s.swarm.clone().with_seed(seed),
+                ..s.clone()
+            };
+            let mut planner = Planner::new(&st);
+            let out = planner
+                .plan(
+                    &problem,
+                    &st,
+                    Deadline::after(clock, Duration::from_secs(30)),
+                )
+                .unwrap();
+            let ratio = out.cost / reference;
+            ratios.push(ratio);
+            times.push(out.times.total.as_secs_f64() * 1e3);
+            if std::env::var("PROBE_RANKING").is_ok() {
+                let best = out
+                    .nlp
+                    .ranking
+                    .iter()
+                    .cloned()
+                    .fold(f64::INFINITY, f64::min);
+                println!(
+                    "  seed {seed}: ratio {ratio:.4} ranking/best {:?}",
+                    out.nlp
+                        .ranking
+                        .iter()
+                        .map(|c| format!("{:.4}", c / best))
+                        .collect::<Vec<_>>()
+                );
+            }
+            if seed == 1 {
+                line = format!(
+                    "swarm {:.0} nlp {:.0} it {:?} q {:?}",
+                    out.times.swarm.as_secs_f64() * 1e3,
+                    out.times.nlp.as_secs_f64() * 1e3,
+                    out.nlp.iterations,
+                    out.quality
+                );
+            }
+        }
+        times.sort_by(f64::total_cmp);
+        let max_ratio = ratios.iter().cloned().fold(0.0, f64::max);
+        worst = worst.max(max_ratio);
+        println!(
+            "{name:<36} med {:7.1} ms max {:7.1} | cost/ref max {:.5} [{}] | {line}",
+            times[times.len() / 2],
+            times[times.len() - 1],
+            max_ratio,
+            ratios
+                .iter()
+                .map(|r| format!("{r:.4}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
+    }
+    println!("worst cost/ref {worst:.5}");
+}
