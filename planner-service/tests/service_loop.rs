@@ -54,5 +54,50 @@ fn a_popup_during_a_plan_is_checked_against_the_new_plan() {
         (s.state[0] - target[0]).hypot(s.state[1] - target[1]) < 2000.0
     });
     assert!(through, "the tasking's plan visits the target");
-    let _ = state_at;
+}
+
+/// B2: a deviation waiting behind the compute gate, joined by a pop-up, re-plans from the
+/// ownship's (dead-reckoned) state although the plan is named after the pop-up: the
+/// splice looks at every pending trigger, not the highest-priority one.
+#[test]
+fn a_deviation_coalesced_with_a_popup_splices_from_the_ownship() {
+    let mut cfg = test_config(&vehicle("deviation-popup"));
+    cfg.budget.min_spacing_ms = 4000;
+    let mut d = Driven::new(cfg);
+    d.first_plan("2d-min-time-avoidable");
+    let plan = d.h.plans[0].clone();
+    // At t = 10 s the aircraft is 3 km east of the plan, heading north.
+    let t = 10.0;
+    let on = state_at(&plan, t).unwrap();
+    let mut own = ownship_2d(t, 1, [on[0] + 3000.0, on[1], std::f64::consts::FRAC_PI_2]);
+    own.cross_track_m = -3000.0;
+    d.h.set_time(t);
+    d.h.send_ownship(own);
+    d.pass();
+    assert_eq!(
+        d.status().triggers_deferred,
+        1,
+        "precondition: the deviation waits for the gate"
+    );
+    let ahead = state_at(&plan, 100.0).unwrap();
+    d.h.send_threat(static_threat(
+        81,
+        [ahead[0], ahead[1], 0.0],
+        [1500.0, 1500.0, 0.0],
+    ));
+    d.pass();
+    d.settle();
+    assert_eq!(d.status().plans_made, 2, "one plan for both triggers");
+    let p = d.h.plans.last().unwrap();
+    assert_eq!(p.trigger(), Some(Trigger::PopUp), "named by priority");
+    // Commit at now + budget (20 s), from the ownship flown on at 200 m/s heading north.
+    let t_c = t + 20.0;
+    assert!((p.start_time_s - t_c).abs() < 1e-6, "{}", p.start_time_s);
+    let x0 = p.samples()[0].state;
+    let expected = [own.state[0], own.state[1] + 200.0 * 20.0];
+    assert!(
+        (x0[0] - expected[0]).hypot(x0[1] - expected[1]) < 1.0,
+        "starts from the ownship's state {expected:?}, not the plan's: {:?}",
+        &x0[..2]
+    );
 }

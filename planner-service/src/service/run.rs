@@ -791,12 +791,13 @@ impl MessageLoop {
             self.pending.wake_at = self.gate.earliest_start(wall, budget);
             return false;
         }
-        let Some(trigger) = self.pending.set.primary() else {
+        let set = self.pending.set;
+        let Some(trigger) = set.primary() else {
             return false;
         };
         let created_at_s = self.pending.created_at_s;
         self.pending = Pending::default();
-        let Some(splice) = self.splice(trigger, budget) else {
+        let Some(splice) = self.splice(set, budget) else {
             return true;
         };
         let Some(tasking) = self.world.tasking else {
@@ -843,14 +844,16 @@ impl MessageLoop {
         true
     }
 
-    /// Where a plan for `trigger` starts: the tasking's start for the first plan; else the
-    /// commit time `now + budget` and the state the current plan predicts there (the state
-    /// the tracker will be in), or the ownship's state dead-reckoned to it when the plan
-    /// cannot say (a deviation, a safe hold, a restart, past the plan's end). Targets the
-    /// current plan passes before the commit time are left out. `None`: nothing to plan
-    /// (the mission is over).
-    fn splice(&self, trigger: Trigger, budget: Duration) -> Option<Splice> {
+    /// Where a plan for the pending triggers `set` starts: the tasking's start for the
+    /// first plan; else the commit time `now + budget` and the state the current plan
+    /// predicts there (the state the tracker will be in), or the ownship's state
+    /// dead-reckoned to it when the plan cannot say (a deviation or a restart among the
+    /// pending triggers, whichever names the plan; a safe hold; past the plan's end).
+    /// Targets the current plan passes before the commit time are left out. `None`:
+    /// nothing to plan (the mission is over).
+    fn splice(&self, set: TriggerSet, budget: Duration) -> Option<Splice> {
         let t = self.world.tasking.as_ref()?;
+        let trigger = set.primary()?;
         if trigger == Trigger::Initial {
             return Some(Splice {
                 t0: t.start_time_s,
@@ -878,10 +881,10 @@ impl MessageLoop {
         };
         let own = self.world.ownship.as_ref();
         let holding = own.is_some_and(OwnshipState::holding);
-        let from_ownship = matches!(trigger, Trigger::Deviation | Trigger::Restart) || holding;
+        let from_ownship = triggers::splice_from_ownship(set, holding);
         let mission_over =
             plan.is_some_and(|p| p.valid_until_s >= p.final_time_s && t_c >= p.final_time_s);
-        if mission_over && matches!(trigger, Trigger::PopUp | Trigger::ScheduledReplan) {
+        if mission_over && set.only_of(&[Trigger::PopUp, Trigger::ScheduledReplan]) {
             info!(
                 trigger = trigger.name(),
                 "the plan ends before the commit time: no re-plan"

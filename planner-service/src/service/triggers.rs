@@ -249,8 +249,21 @@ impl TriggerSet {
         self.0 == 1 << Trigger::PopUp.to_wire()
     }
 
+    /// Whether every pending trigger is one of `allowed`.
+    pub fn only_of(&self, allowed: &[Trigger]) -> bool {
+        let mask = allowed.iter().fold(0, |m, t| m | 1 << t.to_wire());
+        self.0 & !mask == 0
+    }
+
     /// The trigger a plan made for this set is named after.
     pub fn primary(&self) -> Option<Trigger> {
         PRIORITY.into_iter().find(|t| self.contains(*t))
     }
+}
+
+/// Whether a re-plan for the pending triggers `set` starts from the ownship's state rather
+/// than from the state the current plan predicts: the aircraft left the plan (a deviation
+/// or a restart is pending, whatever trigger names the plan) or flies a safe hold.
+pub fn splice_from_ownship(set: TriggerSet, holding: bool) -> bool {
+    set.contains(Trigger::Deviation) || set.contains(Trigger::Restart) || holding
 }
