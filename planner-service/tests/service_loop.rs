@@ -101,3 +101,36 @@ fn a_deviation_coalesced_with_a_popup_splices_from_the_ownship() {
         &x0[..2]
     );
 }
+
+/// B3: an ownship state reporting `plan_id = u64::MAX` (valid on the wire) cannot make the
+/// plan ids overflow and wrap to 0 ("no plan"): an id that large is not continued from.
+#[test]
+fn a_huge_plan_id_from_the_ownship_does_not_overflow_the_plan_ids() {
+    let mut d = Driven::new(test_config(&vehicle("plan-id-max")));
+    let sc = wingman_planner::scenario::bundled("2d-min-time-avoidable")
+        .unwrap()
+        .unwrap();
+    d.h.set_time(0.0);
+    d.h.send_ownship(ownship_2d(0.0, u64::MAX, [0.0, 0.0, std::f64::consts::FRAC_PI_2]));
+    for t in scenario_threats(&sc) {
+        d.h.send_threat(t);
+    }
+    d.h.send_tasking(tasking_from(&sc, 1));
+    d.settle();
+    assert_eq!(d.status().plans_made, 1);
+    let first = d.h.plans[0].plan_id;
+    assert_eq!(first, 1, "the huge id is not continued from");
+    // A re-plan: its id follows.
+    std::thread::sleep(Duration::from_millis(300));
+    let ahead = state_at(&d.h.plans[0], 100.0).unwrap();
+    d.h.set_time(5.0);
+    d.h.send_threat(static_threat(
+        82,
+        [ahead[0], ahead[1], 0.0],
+        [1500.0, 1500.0, 0.0],
+    ));
+    d.settle();
+    assert_eq!(d.status().plans_made, 2);
+    assert_eq!(d.h.plans[1].plan_id, 2);
+    assert_eq!(d.status().current_plan_id, 2);
+}

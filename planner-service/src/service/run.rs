@@ -56,6 +56,10 @@ use crate::dynamics::{VehicleLimits, idx3};
 use crate::hybrid::{PlanOutcome, PlannerSettings};
 use crate::problem::Problem;
 
+/// Largest plan id (exclusive) a restarted planner continues from: far above any real
+/// mission's count, far below `u64::MAX`, so plan ids never wrap to 0 ("no plan").
+pub const MAX_CONTINUED_PLAN_ID: u64 = 1 << 48;
+
 /// A request to stop the service, from another thread (tests; `main` uses signals).
 #[derive(Debug, Clone, Default)]
 pub struct Shutdown(Arc<AtomicBool>);
@@ -274,6 +278,7 @@ pub struct MessageLoop {
     scheduled_fired_for: u64,
     logged_rejections: [[bool; 7]; Input::COUNT],
     logged_receive_errors: [bool; Input::COUNT],
+    logged_plan_id: bool,
     last_status: PlannerStatus,
     // Declared last: dropped after every port.
     node: Node<Ipc>,
@@ -351,6 +356,7 @@ impl MessageLoop {
             scheduled_fired_for: 0,
             logged_rejections: [[false; 7]; Input::COUNT],
             logged_receive_errors: [false; Input::COUNT],
+            logged_plan_id: false,
             last_status: PlannerStatus::zeroed(),
             node,
             cfg,
@@ -552,8 +558,21 @@ impl MessageLoop {
 
     fn on_ownship(&mut self, s: &OwnshipState) {
         self.world.apply_ownship(s);
-        // Plan ids keep growing across a restart of the planner.
-        self.next_plan_id = self.next_plan_id.max(s.plan_id.saturating_add(1));
+        // Plan ids keep growing across a restart of the planner: before its first plan,
+        // the planner continues above the id the tracker flies. Once it has a plan, the
+        // ids are its own. An id too large to continue from is refused (logged once).
+        if !self.has_plan && s.plan_id >= self.next_plan_id {
+            if s.plan_id < MAX_CONTINUED_PLAN_ID {
+                self.next_plan_id = s.plan_id + 1;
+            } else if !self.logged_plan_id {
+                self.logged_plan_id = true;
+                error!(
+                    plan_id = s.plan_id,
+                    limit = MAX_CONTINUED_PLAN_ID,
+                    "the ownship reports a plan id too large to continue from; ignored"
+                );
+            }
+        }
     }
 
     fn on_threat(&mut self, r: &ThreatReport) {
@@ -1021,7 +1040,10 @@ impl MessageLoop {
         self.plan_targets_from = ticket.targets_from;
         self.publish_plan();
         self.plan_sequence += 1;
-        self.next_plan_id += 1;
+        match self.next_plan_id.checked_add(1) {
+            Some(n) => self.next_plan_id = n,
+            None => error!("plan ids exhausted: the next plan repeats the id"),
+        }
         self.counters.plans += 1;
         info!(
             plan_id = self.current.plan_id,
