@@ -134,3 +134,33 @@ fn a_huge_plan_id_from_the_ownship_does_not_overflow_the_plan_ids() {
     assert_eq!(d.h.plans[1].plan_id, 2);
     assert_eq!(d.status().current_plan_id, 2);
 }
+
+/// B4: a tasking that repeats the held one under a larger revision keeps the targets
+/// already passed: the next re-plan does not fly back to them.
+#[test]
+fn a_repeated_tasking_with_a_new_revision_keeps_the_passed_targets() {
+    let mut d = Driven::new(test_config(&vehicle("tasking-repeat")));
+    let sc = d.first_plan("2d-min-time-avoidable");
+    let plan = d.h.plans[0].clone();
+    let passed = plan.phase_ends()[0] + 1.0;
+    d.h.set_time(passed);
+    d.h.send_tasking(tasking_from(&sc, 2));
+    d.pass();
+    assert_eq!(d.status().plans_made, 1, "the same content does not re-plan");
+    std::thread::sleep(Duration::from_millis(300));
+    let ahead = state_at(&plan, passed + 60.0).unwrap();
+    d.h.send_threat(static_threat(
+        83,
+        [ahead[0], ahead[1], 0.0],
+        [1500.0, 1500.0, 0.0],
+    ));
+    d.settle();
+    assert_eq!(d.status().plans_made, 2);
+    let p = d.h.plans.last().unwrap();
+    assert_eq!(p.trigger(), Some(Trigger::PopUp));
+    assert_eq!(
+        p.phase_count, 1,
+        "the target passed at {:.1} s is not visited again",
+        plan.phase_ends()[0]
+    );
+}

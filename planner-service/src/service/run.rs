@@ -259,6 +259,8 @@ pub struct MessageLoop {
     /// Tasking revision and passed targets the current plan was made with.
     plan_revision: u32,
     plan_targets_from: usize,
+    /// The first revision with the held tasking's content (later ones only repeat it).
+    content_revision: u32,
     points: PlanPoints,
     /// The problem buffers, lent to the solver while a plan is in flight.
     problem: Option<Box<Problem>>,
@@ -339,6 +341,7 @@ impl MessageLoop {
             has_plan: false,
             plan_revision: 0,
             plan_targets_from: 0,
+            content_revision: 0,
             points: PlanPoints::with_capacity(),
             problem: Some(Box::new(super::world::reusable_problem())),
             in_flight: None,
@@ -522,7 +525,11 @@ impl MessageLoop {
     }
 
     fn on_tasking(&mut self, t: &Tasking) {
-        match self.world.apply_tasking(t) {
+        let decision = self.world.apply_tasking(t);
+        if matches!(decision, TaskingDecision::First | TaskingDecision::Changed) {
+            self.content_revision = t.revision;
+        }
+        match decision {
             TaskingDecision::First => self.awaiting_first = true,
             TaskingDecision::Changed => {
                 info!(revision = t.revision, "tasking changed");
@@ -888,7 +895,9 @@ impl MessageLoop {
         };
         let plan = self.has_plan.then_some(&*self.current);
         let targets_from = match plan {
-            Some(p) if self.plan_revision == t.revision => {
+            // The plan was made from this tasking's content (a later revision that only
+            // repeats it keeps the passed targets).
+            Some(p) if (self.content_revision..=t.revision).contains(&self.plan_revision) => {
                 let phases = p.phase_ends();
                 let passed = phases[..phases.len().saturating_sub(1)]
                     .iter()
