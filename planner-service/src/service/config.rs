@@ -114,8 +114,8 @@ impl Default for ServiceConfig {
 impl Default for BudgetConfig {
     fn default() -> Self {
         BudgetConfig {
-            plan_2d_ms: 150,
-            plan_3d_ms: 600,
+            plan_2d_ms: 500,
+            plan_3d_ms: 2500,
             min_spacing_ms: 250,
             duty_cycle: 0.5,
             duty_window_ms: 10_000,
