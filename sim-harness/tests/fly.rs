@@ -2,7 +2,8 @@
 //! `wingman-planner serve`), in the fast clock: a short 2-D canonical scenario completes,
 //! its log replays with every plan identical, an external planner works the same, and a
 //! planner that dies at start-up or a broken scenario end the harness with an error
-//! instead of a hang. Every test has its own vehicle id and output folder; a watchdog
+//! instead of a hang. (Every canonical scenario, `3d-replan-popups`' re-plans included, is
+//! flown by `tests/tests/canonical.rs`.) Every test has its own vehicle id and output folder; a watchdog
 //! kills a child that outlives its limit; `Drop` cleans up.
 
 use std::path::{Path, PathBuf};
@@ -229,60 +230,4 @@ fn a_planner_that_dies_at_start_up_or_a_broken_scenario_is_an_error() {
     );
     let o = harness(&["fly", "no-such-scenario", "--quiet"], None).wait(Duration::from_secs(60));
     assert_eq!(o.status.code(), Some(2));
-}
-
-/// The closed-loop canonical mission (issue 7's "must show"): a re-plan for the moving
-/// pop-up at 60 s, the scheduled re-plan it leads to, none for the far pop-up at 300 s,
-/// one for the lead's new route at 450 s, the rendezvous on the new route; re-plans are
-/// charged their compute time (lock-step clock).
-#[test]
-fn the_replan_popups_mission_replans_for_the_right_events_only() {
-    let dir = TempDir::new("popups");
-    let out = dir.0.join("run");
-    let v = vehicle("popups");
-    let o = harness(
-        &["fly", "3d-replan-popups", "--quiet", "--vehicle", &v],
-        Some(&out),
-    )
-    .wait(LIMIT);
-    assert!(o.status.success(), "{}", text(&o));
-    let r = report(&out);
-    assert_completed(&r);
-    assert!(out.join("side.png").exists());
-    let plans = r["plans"].as_array().unwrap();
-    let triggers: Vec<(&str, f64)> = plans
-        .iter()
-        .map(|p| (p["trigger"].as_str().unwrap(), p["at_s"].as_f64().unwrap()))
-        .collect();
-    let near = |t: f64, at: f64| (t - at).abs() < 0.5;
-    assert!(
-        triggers.iter().any(|&(k, t)| k == "PopUp" && near(t, 60.0)),
-        "{triggers:?}"
-    );
-    assert!(
-        triggers
-            .iter()
-            .any(|&(k, t)| k == "ScheduledReplan" && t > 60.0),
-        "{triggers:?}"
-    );
-    assert!(
-        !triggers.iter().any(|&(_, t)| near(t, 300.0)),
-        "a re-plan for the far pop-up: {triggers:?}"
-    );
-    assert!(
-        triggers
-            .iter()
-            .any(|&(k, t)| k == "LeadRoute" && near(t, 450.0)),
-        "{triggers:?}"
-    );
-    assert!(r["planner"]["popups_clear"].as_u64().unwrap() >= 1);
-    assert!(r["holds"].as_array().unwrap().is_empty());
-    // Re-plans may be flown from their trigger time plus their compute time on.
-    for p in &plans[1..] {
-        let charged = p["at_s"].as_f64().unwrap() + p["compute_ms"].as_f64().unwrap() / 1e3;
-        let available = p["available_at_s"].as_f64().unwrap();
-        assert!((available - charged).abs() < 1e-6, "{p}");
-    }
-    // The rendezvous is on the lead's new route, after it changed.
-    assert!(r["end_s"].as_f64().unwrap() > 450.0);
 }

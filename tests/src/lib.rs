@@ -2,6 +2,8 @@
 //! of the workspace, in the same profile as the running test.
 
 pub mod judge;
+pub mod outcome;
+pub mod process;
 pub mod random_scenario;
 
 use std::path::{Path, PathBuf};
