@@ -50,9 +50,10 @@ fn a_popup_during_a_plan_is_checked_against_the_new_plan() {
     assert_eq!(d.h.plans[1].trigger(), Some(Trigger::Tasking));
     // The tasking's plan indeed went through the pop-up (it visits the target).
     let p = &d.h.plans[1];
-    let through = p.samples().iter().any(|s| {
-        (s.state[0] - target[0]).hypot(s.state[1] - target[1]) < 2000.0
-    });
+    let through = p
+        .samples()
+        .iter()
+        .any(|s| (s.state[0] - target[0]).hypot(s.state[1] - target[1]) < 2000.0);
     assert!(through, "the tasking's plan visits the target");
 }
 
@@ -111,7 +112,11 @@ fn a_huge_plan_id_from_the_ownship_does_not_overflow_the_plan_ids() {
         .unwrap()
         .unwrap();
     d.h.set_time(0.0);
-    d.h.send_ownship(ownship_2d(0.0, u64::MAX, [0.0, 0.0, std::f64::consts::FRAC_PI_2]));
+    d.h.send_ownship(ownship_2d(
+        0.0,
+        u64::MAX,
+        [0.0, 0.0, std::f64::consts::FRAC_PI_2],
+    ));
     for t in scenario_threats(&sc) {
         d.h.send_threat(t);
     }
@@ -146,7 +151,11 @@ fn a_repeated_tasking_with_a_new_revision_keeps_the_passed_targets() {
     d.h.set_time(passed);
     d.h.send_tasking(tasking_from(&sc, 2));
     d.pass();
-    assert_eq!(d.status().plans_made, 1, "the same content does not re-plan");
+    assert_eq!(
+        d.status().plans_made,
+        1,
+        "the same content does not re-plan"
+    );
     std::thread::sleep(Duration::from_millis(300));
     let ahead = state_at(&plan, passed + 60.0).unwrap();
     d.h.send_threat(static_threat(
@@ -159,8 +168,47 @@ fn a_repeated_tasking_with_a_new_revision_keeps_the_passed_targets() {
     let p = d.h.plans.last().unwrap();
     assert_eq!(p.trigger(), Some(Trigger::PopUp));
     assert_eq!(
-        p.phase_count, 1,
+        p.phase_count,
+        1,
         "the target passed at {:.1} s is not visited again",
         plan.phase_ends()[0]
     );
+}
+
+/// B7: a first plan that fails (here the solver refuses a 3-D start state climbing
+/// steeper than the vehicle's bound, which the tasking's `validate()` cannot see) is tried again after
+/// `FIRST_PLAN_RETRY` (and at once with a new tasking), rather than leaving the service without a plan for good.
+#[test]
+fn a_failed_first_plan_is_tried_again() {
+    let mut d = Driven::new(test_config(&vehicle("first-fails")));
+    let sc = wingman_planner::scenario::bundled("3d-min-time-avoidable")
+        .unwrap()
+        .unwrap();
+    let mut t = tasking_from(&sc, 1);
+    t.start_state[3] = t.limits.gamma_max_rad + 0.1; // climbing steeper than allowed
+    d.h.set_time(0.0);
+    d.h.send_tasking(t);
+    d.settle();
+    let s = d.status();
+    assert_eq!(s.plans_made, 0);
+    assert_eq!(s.state(), Some(PlannerState::Degraded));
+    // After the retry wait, the next pass starts another attempt.
+    std::thread::sleep(
+        wingman_planner::service::run::FIRST_PLAN_RETRY + Duration::from_millis(100),
+    );
+    d.pass();
+    assert_eq!(
+        d.status().state(),
+        Some(PlannerState::Planning),
+        "the first plan is tried again"
+    );
+    d.settle();
+    // Corrected, the next attempt starts at once (past the gate's spacing) and plans.
+    std::thread::sleep(Duration::from_millis(300));
+    d.h.send_tasking(tasking_from(&sc, 2));
+    d.pass();
+    assert_eq!(d.status().state(), Some(PlannerState::Planning));
+    d.settle();
+    assert_eq!(d.status().plans_made, 1);
+    assert_eq!(d.status().current_plan_id, 1);
 }

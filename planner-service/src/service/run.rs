@@ -60,6 +60,11 @@ use crate::problem::Problem;
 /// mission's count, far below `u64::MAX`, so plan ids never wrap to 0 ("no plan").
 pub const MAX_CONTINUED_PLAN_ID: u64 = 1 << 48;
 
+/// Wall-clock wait before a failed first plan is tried again with the same inputs (the
+/// planner is deterministic: an immediate retry would fail the same way; the mission
+/// time, and with it a restart's start, moves on meanwhile).
+pub const FIRST_PLAN_RETRY: Duration = Duration::from_secs(2);
+
 /// A request to stop the service, from another thread (tests; `main` uses signals).
 #[derive(Debug, Clone, Default)]
 pub struct Shutdown(Arc<AtomicBool>);
@@ -270,6 +275,9 @@ pub struct MessageLoop {
     batch_count: u64,
     /// A first tasking (or one after a failed first plan) waits for its plan.
     awaiting_first: bool,
+    /// After a failed first plan: wall-clock time of the next attempt with the same
+    /// inputs (a new tasking or route tries at once).
+    retry_first_at: Option<Duration>,
     gate: ComputeGate,
     counters: Counters,
     next_plan_id: u64,
@@ -349,6 +357,7 @@ impl MessageLoop {
             batch: TriggerSet::EMPTY,
             batch_count: 0,
             awaiting_first: false,
+            retry_first_at: None,
             gate,
             counters: Counters::default(),
             next_plan_id: 1,
@@ -531,6 +540,11 @@ impl MessageLoop {
         }
         match decision {
             TaskingDecision::First => self.awaiting_first = true,
+            TaskingDecision::Changed if !self.has_plan && self.in_flight.is_none() => {
+                info!(revision = t.revision, "tasking changed before a first plan");
+                self.awaiting_first = true;
+                self.retry_first_at = None;
+            }
             TaskingDecision::Changed => {
                 info!(revision = t.revision, "tasking changed");
                 if self.has_plan || self.in_flight.is_some() {
@@ -539,6 +553,9 @@ impl MessageLoop {
                     self.awaiting_first = true;
                 }
             }
+            // Only the start may differ (it is not compared): a waiting first plan uses it
+            // at once.
+            TaskingDecision::Unchanged if !self.has_plan => self.retry_first_at = None,
             TaskingDecision::Unchanged | TaskingDecision::Stale => {}
         }
     }
@@ -556,6 +573,14 @@ impl MessageLoop {
         {
             info!(revision = r.revision, "lead route changed");
             self.raise(Trigger::LeadRoute);
+        } else if matches!(decision, RouteDecision::First | RouteDecision::Changed)
+            && !self.has_plan
+            && self.in_flight.is_none()
+            && self.world.tasking.is_some()
+        {
+            // No plan yet (none made, or the first one failed): try with this route.
+            self.awaiting_first = true;
+            self.retry_first_at = None;
         }
     }
 
@@ -717,13 +742,16 @@ impl MessageLoop {
     fn evaluate(&mut self) -> bool {
         let now = self.world.now_s();
         let lead = self.budget().as_secs_f64();
+        let retry_due = self.retry_first_at.is_none_or(|at| self.clock.now() >= at);
         if self.awaiting_first
+            && retry_due
             && let Some(t) = &self.world.tasking
         {
             let needs_route = t.objective() == Some(Objective::MinTimeRendezvous);
             if !needs_route || self.world.route.is_some() {
                 let trigger = triggers::first_plan_trigger(t, self.world.ownship.as_ref());
                 self.awaiting_first = false;
+                self.retry_first_at = None;
                 self.raise(trigger);
             }
         }
@@ -966,8 +994,16 @@ impl MessageLoop {
         self.counters.last_compute_ms = compute_ms;
         match outcome {
             Ok(o) => self.accept(&o, &ticket, compute_ms),
-            // Without a plan the status says `Degraded`; a new tasking tries again.
-            Err(e) => warn!(trigger = ticket.trigger.name(), error = %e, "no plan made"),
+            Err(e) => {
+                warn!(trigger = ticket.trigger.name(), error = %e, "no plan made");
+                // Without a plan the status says `Degraded`; the first plan is tried again
+                // (the compute gate spaces the attempts), and a new tasking or route is
+                // taken into the next attempt.
+                if !self.has_plan {
+                    self.awaiting_first = true;
+                    self.retry_first_at = Some(self.clock.now() + FIRST_PLAN_RETRY);
+                }
+            }
         }
         // Threats that changed while the plan was computed are not in it: check each
         // against the plan now current (a pop-up clear of the old plan may lie on the new
