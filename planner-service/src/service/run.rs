@@ -228,6 +228,8 @@ struct Counters {
     coalesced: u64,
     deferred: u64,
     popups_clear: u64,
+    /// Track fixes the Kalman filter refused (logged once, reported at exit).
+    fixes_refused: u64,
     last_compute_ms: f64,
 }
 
@@ -289,6 +291,7 @@ pub struct MessageLoop {
     logged_rejections: [[bool; 7]; Input::COUNT],
     logged_receive_errors: [bool; Input::COUNT],
     logged_plan_id: bool,
+    logged_fix_refused: bool,
     last_status: PlannerStatus,
     // Declared last: dropped after every port.
     node: Node<Ipc>,
@@ -369,6 +372,7 @@ impl MessageLoop {
             logged_rejections: [[false; 7]; Input::COUNT],
             logged_receive_errors: [false; Input::COUNT],
             logged_plan_id: false,
+            logged_fix_refused: false,
             last_status: PlannerStatus::zeroed(),
             node,
             cfg,
@@ -460,6 +464,11 @@ impl MessageLoop {
         self.pending = Pending::default();
         self.publish_status();
         let status = self.last_status;
+        info!(
+            fixes_refused = self.counters.fixes_refused,
+            threats_dropped = self.world.threats_dropped,
+            "inputs the world model could not take"
+        );
         let MessageLoop { solver, .. } = self;
         solver.shutdown(Duration::from_secs(2));
         status
@@ -613,10 +622,16 @@ impl MessageLoop {
             ThreatChange::New(s) | ThreatChange::Changed(s) => s,
             ThreatChange::Unchanged => return,
             ThreatChange::Full => {
-                warn!(
-                    threat = r.threat_id,
-                    "no room for another threat: report ignored"
-                );
+                // Logged once; the status says `Degraded` from now on.
+                if self.world.threats_dropped == 1 {
+                    error!(
+                        threat = r.threat_id,
+                        static_capacity = super::world::MAX_STATIC_THREATS,
+                        moving_capacity = super::world::MAX_MOVING_THREATS,
+                        "no room for another threat: report ignored, the planner is Degraded \
+                         (further ones are only counted)"
+                    );
+                }
                 return;
             }
             ThreatChange::Refused(e) => {
@@ -660,7 +675,18 @@ impl MessageLoop {
                     self.schedule(i);
                 }
             }
-            FixOutcome::UnknownThreat | FixOutcome::Refused(_) => {}
+            FixOutcome::Refused(e) => {
+                self.counters.fixes_refused += 1;
+                if !self.logged_fix_refused {
+                    self.logged_fix_refused = true;
+                    warn!(
+                        threat = f.threat_id,
+                        error = %e,
+                        "a track fix was refused by the filter (further ones are only counted)"
+                    );
+                }
+            }
+            FixOutcome::UnknownThreat => {}
         }
     }
 
@@ -1132,7 +1158,10 @@ impl MessageLoop {
         // harness then waits for it as for a plan in flight.
         let state = if self.in_flight.is_some() || !self.pending.set.is_empty() {
             PlannerState::Planning
-        } else if stale != 0 || (self.world.tasking.is_some() && !self.has_plan) {
+        } else if stale != 0
+            || (self.world.tasking.is_some() && !self.has_plan)
+            || self.world.threats_dropped > 0
+        {
             PlannerState::Degraded
         } else {
             PlannerState::Idle

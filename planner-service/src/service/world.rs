@@ -121,13 +121,17 @@ impl MovingTrack {
     }
 
     /// Predict to the fix's time, then update with its position projected on the road.
+    /// A fix the filter refuses leaves the track as it was (not predicted half-way).
     fn apply_fix(&mut self, fix: &TrackFix, now: Duration) -> Result<(), EstimationError> {
-        if fix.sigma_m != self.meas_sigma {
-            self.filter = KalmanFilter::new(self.model, fix.sigma_m, *self.filter.estimate())?;
-            self.meas_sigma = fix.sigma_m;
-        }
-        self.filter.predict_to(fix.time_s)?;
-        self.filter.update_position(&self.road, &fix.position_m)?;
+        let mut filter = if fix.sigma_m != self.meas_sigma {
+            KalmanFilter::new(self.model, fix.sigma_m, *self.filter.estimate())?
+        } else {
+            self.filter
+        };
+        filter.predict_to(fix.time_s)?;
+        filter.update_position(&self.road, &fix.position_m)?;
+        self.filter = filter;
+        self.meas_sigma = fix.sigma_m;
         self.last_update = now;
         Ok(())
     }
@@ -221,6 +225,9 @@ pub struct World {
     pub max_sequence: u64,
     /// Grows with every change of the threat world.
     pub epoch: u64,
+    /// Threat reports refused for lack of room (the status then says `Degraded`: the
+    /// planner ignores a threat).
+    pub threats_dropped: u64,
     last_seen: [Option<Duration>; Input::COUNT],
     last_header: [Option<Header>; Input::COUNT],
 }
@@ -237,6 +244,7 @@ impl Default for World {
             now_ns: i64::MIN,
             max_sequence: 0,
             epoch: 0,
+            threats_dropped: 0,
             last_seen: [None; Input::COUNT],
             last_header: [None; Input::COUNT],
         }
@@ -307,19 +315,14 @@ impl World {
         self.ownship = Some(*s);
     }
 
-    /// Takes a threat report: the latest report per `threat_id` wins.
+    /// Takes a threat report: the latest report per `threat_id` wins. A threat that
+    /// changes kind leaves its old table only once the new entry is stored: a report that
+    /// is refused (no room, or a filter that refuses it) changes nothing. A report refused
+    /// for room is counted in [`World::threats_dropped`].
     pub fn apply_threat(&mut self, r: &ThreatReport, wall: Duration) -> ThreatChange {
         let moving = r.kind() == Some(ThreatKind::Moving);
-        // A threat that changed kind leaves its old table.
-        if moving {
-            if let Some(i) = self.static_index(r.threat_id) {
-                self.statics[i] = None;
-            }
-        } else if let Some(i) = self.moving_index(r.threat_id) {
-            self.movings[i] = None;
-        }
         let epoch = self.epoch + 1;
-        if moving {
+        let change = if moving {
             let existing = self.moving_index(r.threat_id);
             if let Some(i) = existing
                 && let Some(m) = &self.movings[i]
@@ -327,19 +330,24 @@ impl World {
             {
                 return ThreatChange::Unchanged;
             }
-            let track = match MovingTrack::new(r, wall, epoch) {
-                Ok(t) => t,
-                Err(e) => return ThreatChange::Refused(e),
-            };
             let (slot, change) = match existing {
                 Some(i) => (i, ThreatChange::Changed(ThreatSlot::Moving(i))),
                 None => match self.movings.iter().position(Option::is_none) {
                     Some(i) => (i, ThreatChange::New(ThreatSlot::Moving(i))),
-                    None => return ThreatChange::Full,
+                    None => {
+                        self.threats_dropped += 1;
+                        return ThreatChange::Full;
+                    }
                 },
             };
+            let track = match MovingTrack::new(r, wall, epoch) {
+                Ok(t) => t,
+                Err(e) => return ThreatChange::Refused(e),
+            };
             self.movings[slot] = Some(track);
-            self.epoch = epoch;
+            if let Some(i) = self.static_index(r.threat_id) {
+                self.statics[i] = None;
+            }
             change
         } else {
             let existing = self.static_index(r.threat_id);
@@ -353,13 +361,20 @@ impl World {
                 Some(i) => (i, ThreatChange::Changed(ThreatSlot::Static(i))),
                 None => match self.statics.iter().position(Option::is_none) {
                     Some(i) => (i, ThreatChange::New(ThreatSlot::Static(i))),
-                    None => return ThreatChange::Full,
+                    None => {
+                        self.threats_dropped += 1;
+                        return ThreatChange::Full;
+                    }
                 },
             };
             self.statics[slot] = Some(StaticThreat { report: *r, epoch });
-            self.epoch = epoch;
+            if let Some(i) = self.moving_index(r.threat_id) {
+                self.movings[i] = None;
+            }
             change
-        }
+        };
+        self.epoch = epoch;
+        change
     }
 
     /// Feeds a track fix to its moving threat's filter.
