@@ -212,3 +212,87 @@ fn a_failed_first_plan_is_tried_again() {
     assert_eq!(d.status().plans_made, 1);
     assert_eq!(d.status().current_plan_id, 1);
 }
+
+/// B6: a tasking that switches the model (2-D to 3-D) starts the new plan from the
+/// ownship's state in the new model, never from the old 2-D plan's `(x, y, psi)` read as
+/// a 3-D state (whose altitude would be `psi`).
+#[test]
+fn a_model_change_starts_from_the_ownship_in_the_new_model() {
+    let mut d = Driven::new(test_config(&vehicle("model-change")));
+    d.first_plan("2d-min-time-avoidable");
+    let sc3 = wingman_planner::scenario::bundled("3d-min-time-avoidable")
+        .unwrap()
+        .unwrap();
+    let t3 = tasking_from(&sc3, 2);
+    let t = 10.0;
+    let mut own = OwnshipState::zeroed();
+    own.time_s = t;
+    own.model = Model::ThreeD.to_wire();
+    own.plan_id = 1;
+    own.state = t3.start_state;
+    d.h.set_time(t);
+    d.h.send_ownship(own);
+    std::thread::sleep(Duration::from_millis(300));
+    d.h.send_tasking(t3);
+    d.settle();
+    assert_eq!(d.status().plans_made, 2, "a plan for the 3-D tasking");
+    let p = d.h.plans.last().unwrap();
+    assert_eq!(p.model(), Some(Model::ThreeD));
+    assert_eq!(p.trigger(), Some(Trigger::Tasking));
+    // Dead-reckoned 20 s (the budget) along the ownship's heading and climb.
+    let x0 = p.samples()[0].state;
+    let (sg, cg) = own.state[3].sin_cos();
+    let (sc, cc) = own.state[4].sin_cos();
+    let v = t3.limits.speed_mps * 20.0;
+    let expected = [
+        own.state[0] + v * cg * cc,
+        own.state[1] + v * cg * sc,
+        own.state[2] + v * sg,
+    ];
+    for k in 0..3 {
+        assert!(
+            (x0[k] - expected[k]).abs() < 1.0,
+            "start {:?}, expected {expected:?}",
+            &x0[..3]
+        );
+    }
+}
+
+/// B9: a restart whose ownship state is stale (mission time far past it) does not
+/// dead-reckon it for minutes: the plan waits for a fresh ownship state and starts from
+/// it.
+#[test]
+fn a_restart_does_not_dead_reckon_a_stale_ownship_state() {
+    let mut d = Driven::new(test_config(&vehicle("stale-ownship")));
+    let sc = wingman_planner::scenario::bundled("2d-min-time-avoidable")
+        .unwrap()
+        .unwrap();
+    let north = std::f64::consts::FRAC_PI_2;
+    d.h.set_time(5.0);
+    d.h.send_ownship(ownship_2d(5.0, 7, [0.0, 1000.0, north]));
+    d.h.set_time(300.0);
+    for t in scenario_threats(&sc) {
+        d.h.send_threat(t);
+    }
+    d.h.send_tasking(tasking_from(&sc, 1));
+    d.settle();
+    assert_eq!(
+        d.status().plans_made,
+        0,
+        "no plan from an ownship state 295 s old"
+    );
+    let fresh = [20000.0, 30000.0, 0.0];
+    d.h.send_ownship(ownship_2d(300.0, 7, fresh));
+    d.settle();
+    assert_eq!(d.status().plans_made, 1);
+    let p = &d.h.plans[0];
+    assert_eq!(p.trigger(), Some(Trigger::Restart));
+    assert_eq!(p.plan_id, 8, "plan ids continue above the ownship's");
+    assert!((p.start_time_s - 320.0).abs() < 1e-6, "{}", p.start_time_s);
+    let x0 = p.samples()[0].state;
+    assert!(
+        (x0[0] - (fresh[0] + 200.0 * 20.0)).abs() < 1.0 && (x0[1] - fresh[1]).abs() < 1.0,
+        "from the fresh state flown on 20 s east: {:?}",
+        &x0[..2]
+    );
+}

@@ -245,6 +245,16 @@ struct Pending {
     wake_at: Option<Duration>,
 }
 
+/// Why a plan cannot start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum NoSplice {
+    /// The plan ends before the commit time: nothing to re-plan.
+    MissionOver,
+    /// No state to start from (no fresh ownship state of the tasking's model where the
+    /// plan cannot say).
+    NoStart,
+}
+
 /// A plan being computed.
 #[derive(Debug, Clone, Copy)]
 struct InFlight {
@@ -277,6 +287,9 @@ pub struct MessageLoop {
     batch_count: u64,
     /// A first tasking (or one after a failed first plan) waits for its plan.
     awaiting_first: bool,
+    /// Triggers whose plan had no state to start from (no fresh ownship state where the
+    /// plan cannot say): raised again by the next ownship state of the tasking's model.
+    awaiting_start: Option<TriggerSet>,
     /// After a failed first plan: wall-clock time of the next attempt with the same
     /// inputs (a new tasking or route tries at once).
     retry_first_at: Option<Duration>,
@@ -361,6 +374,7 @@ impl MessageLoop {
             batch_count: 0,
             awaiting_first: false,
             retry_first_at: None,
+            awaiting_start: None,
             gate,
             counters: Counters::default(),
             next_plan_id: 1,
@@ -599,6 +613,14 @@ impl MessageLoop {
 
     fn on_ownship(&mut self, s: &OwnshipState) {
         self.world.apply_ownship(s);
+        let model = self.world.tasking.as_ref().and_then(Tasking::model);
+        if s.model() == model
+            && let Some(set) = self.awaiting_start.take()
+        {
+            info!("an ownship state to start from: the waiting plan starts");
+            self.batch = self.batch.union(set);
+            self.batch_count += 1;
+        }
         // Plan ids keep growing across a restart of the planner: before its first plan,
         // the planner continues above the id the tracker flies. Once it has a plan, the
         // ids are its own. An id too large to continue from is refused (logged once).
@@ -877,8 +899,14 @@ impl MessageLoop {
         };
         let created_at_s = self.pending.created_at_s;
         self.pending = Pending::default();
-        let Some(splice) = self.splice(set, budget) else {
-            return true;
+        let splice = match self.splice(set, budget) {
+            Ok(s) => s,
+            Err(NoSplice::MissionOver) => return true,
+            Err(NoSplice::NoStart) => {
+                // Tried again when the next ownship state of the tasking's model arrives.
+                self.awaiting_start = Some(self.awaiting_start.unwrap_or_default().union(set));
+                return true;
+            }
         };
         let Some(tasking) = self.world.tasking else {
             return true;
@@ -928,14 +956,16 @@ impl MessageLoop {
     /// first plan; else the commit time `now + budget` and the state the current plan
     /// predicts there (the state the tracker will be in), or the ownship's state
     /// dead-reckoned to it when the plan cannot say (a deviation or a restart among the
-    /// pending triggers, whichever names the plan; a safe hold; past the plan's end).
-    /// Targets the current plan passes before the commit time are left out. `None`:
-    /// nothing to plan (the mission is over).
-    fn splice(&self, set: TriggerSet, budget: Duration) -> Option<Splice> {
-        let t = self.world.tasking.as_ref()?;
-        let trigger = set.primary()?;
+    /// pending triggers, whichever names the plan; a safe hold; past the plan's end; a
+    /// tasking of another model). Only a fresh ownship state (mission time within
+    /// `staleness.ownship_ms` of now) of the tasking's model is dead-reckoned; without one
+    /// the plan's own state is used if it can be, else there is no plan for now. Targets
+    /// the current plan passes before the commit time are left out.
+    fn splice(&self, set: TriggerSet, budget: Duration) -> Result<Splice, NoSplice> {
+        let t = self.world.tasking.as_ref().ok_or(NoSplice::NoStart)?;
+        let trigger = set.primary().ok_or(NoSplice::NoStart)?;
         if trigger == Trigger::Initial {
-            return Some(Splice {
+            return Ok(Splice {
                 t0: t.start_time_s,
                 x0: t.start_state,
                 targets_from: 0,
@@ -947,7 +977,11 @@ impl MessageLoop {
         } else {
             t.start_time_s
         };
-        let plan = self.has_plan.then_some(&*self.current);
+        // The current plan, if its states are in the tasking's layout.
+        let plan = self
+            .has_plan
+            .then_some(&*self.current)
+            .filter(|p| p.model() == t.model());
         let targets_from = match plan {
             // The plan was made from this tasking's content (a later revision that only
             // repeats it keeps the passed targets).
@@ -971,33 +1005,55 @@ impl MessageLoop {
                 trigger = trigger.name(),
                 "the plan ends before the commit time: no re-plan"
             );
-            return None;
+            return Err(NoSplice::MissionOver);
         }
         let beyond = plan.is_none_or(|p| t_c > p.final_time_s);
-        let x0 = match (plan, own) {
-            (_, Some(o)) if from_ownship || beyond => dead_reckon(o, t, t_c),
-            (Some(p), _) => {
-                let t0 = t_c.max(p.start_time_s);
-                return Some(Splice {
-                    t0,
-                    x0: export::state_at(p, t0)?,
+        let max_age_s = self.cfg.staleness.ownship_ms as f64 * 1e-3;
+        let reckoned = own.and_then(|o| {
+            let fresh = now - o.time_s <= max_age_s;
+            fresh.then(|| dead_reckon(o, t, t_c)).flatten()
+        });
+        let from_plan = |p: &Plan| {
+            let t0 = t_c.max(p.start_time_s);
+            export::state_at(p, t0).map(|x0| Splice {
+                t0,
+                x0,
+                targets_from,
+            })
+        };
+        if from_ownship || beyond {
+            if let Some(x0) = reckoned {
+                return Ok(Splice {
+                    t0: t_c,
+                    x0,
                     targets_from,
                 });
             }
-            (None, Some(o)) => dead_reckon(o, t, t_c),
-            (None, None) => {
-                return Some(Splice {
-                    t0: t.start_time_s.max(t_c),
-                    x0: t.start_state,
-                    targets_from: 0,
-                });
+            if own.is_some() || plan.is_some() {
+                warn!(
+                    trigger = trigger.name(),
+                    "no fresh ownship state of the tasking's model to start from"
+                );
             }
-        };
-        Some(Splice {
-            t0: t_c,
-            x0,
-            targets_from,
-        })
+        }
+        match plan {
+            Some(p) if !beyond => from_plan(p).ok_or(NoSplice::NoStart),
+            Some(_) => Err(NoSplice::NoStart),
+            None if own.is_none() && !self.has_plan => Ok(Splice {
+                t0: t.start_time_s.max(t_c),
+                x0: t.start_state,
+                targets_from: 0,
+            }),
+            None => {
+                if self.has_plan && reckoned.is_none() {
+                    error!(
+                        "the tasking changed model and no ownship state of the new model is \
+                         fresh: no plan until one arrives"
+                    );
+                }
+                Err(NoSplice::NoStart)
+            }
+        }
     }
 
     // ---------------------------------------------------------------------------------
@@ -1107,6 +1163,7 @@ impl MessageLoop {
             self.schedule(i);
         }
         export::set_next_replan(&mut self.current, self.world.next_replan());
+        self.awaiting_start = None;
         self.plan_revision = ticket.tasking_revision;
         self.plan_targets_from = ticket.targets_from;
         self.publish_plan();
@@ -1209,8 +1266,12 @@ fn solver_waker(vehicle_id: &str) -> Result<Box<dyn FnMut()>, String> {
 }
 
 /// The ownship's state carried forward at constant speed and heading from its time to
-/// `t`, with the 3-D attitude kept inside the tasking's limits.
-fn dead_reckon(o: &OwnshipState, t: &Tasking, at: f64) -> [f64; 7] {
+/// `t`, with the 3-D attitude kept inside the tasking's limits. `None` if the ownship's
+/// state is not in the tasking's model (its layout differs).
+fn dead_reckon(o: &OwnshipState, t: &Tasking, at: f64) -> Option<[f64; 7]> {
+    if o.model().is_none() || o.model() != t.model() {
+        return None;
+    }
     let dt = (at - o.time_s).max(0.0);
     let v = t.limits.speed_mps;
     let mut x = o.state;
@@ -1243,7 +1304,7 @@ fn dead_reckon(o: &OwnshipState, t: &Tasking, at: f64) -> [f64; 7] {
             x[1] += v * s * dt;
         }
     }
-    x
+    Some(x)
 }
 
 /// Index of a validation error's kind (for logging once per kind).
