@@ -397,3 +397,26 @@ fn a_bad_configuration_is_refused_naming_the_key() {
         "the rest keeps its defaults"
     );
 }
+
+/// B5: the duty-cycle cap must hold a plan's budget once per thread it runs on; one
+/// `solver.threads` sets the swarm's and the NLP's threads (`swarm_threads` still reads).
+/// Nit: a bad `plan_3d_ms` is reported under its own key.
+#[test]
+fn the_duty_cycle_cap_holds_a_budget_per_thread() {
+    // 600 ms x 2 threads = 1200 ms > 0.1 x 10 s.
+    let budget = "[budget]\nplan_2d_ms = 300\nplan_3d_ms = 600\nduty_cycle = 0.1\n";
+    let e = ServiceConfig::from_toml(budget, "x.toml").unwrap_err();
+    assert!(
+        e.to_string().contains("budget.duty_cycle") && e.to_string().contains("1200"),
+        "{e}"
+    );
+    // On one thread 600 ms fits 1 s.
+    let one = ServiceConfig::from_toml(&format!("{budget}[solver]\nthreads = 1\n"), "x").unwrap();
+    assert_eq!(one.solver.threads, 1);
+    let old = ServiceConfig::from_toml("[solver]\nswarm_threads = 1\n", "x").unwrap();
+    assert_eq!(old.solver.threads, 1);
+    let e = ServiceConfig::from_toml("[solver]\nthreads = 0\n", "x").unwrap_err();
+    assert!(e.to_string().contains("solver.threads"), "{e}");
+    let e = ServiceConfig::from_toml("[budget]\nplan_3d_ms = 0\n", "x").unwrap_err();
+    assert!(e.to_string().contains("budget.plan_3d_ms"), "{e}");
+}

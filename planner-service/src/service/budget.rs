@@ -4,11 +4,13 @@
 //! - a minimum spacing between the starts of two plans;
 //! - a duty-cycle cap: over any sliding window of `window`, planning may use at most
 //!   `duty_cycle x window` of core time. A plan is admitted only if the time already used
-//!   in the window plus its whole budget fits (its deadline bounds what it can use).
+//!   in the window plus the most it can use fits: its budget (its deadline) times the
+//!   threads it plans on (`solver.threads`: the swarm's workers and the NLP starts solved
+//!   side by side each keep a core busy).
 //!
-//! Core time of a plan is its wall time, with the particle-swarm stage counted once per
-//! swarm worker thread (the swarm runs on `swarm_threads` cores at once). Everything is in
-//! the injected clock's time (`Clock::now()`), fixed-capacity and allocation-free.
+//! Core time of a finished plan is what it really used: the process's CPU time over the
+//! plan (`solver::process_cpu_time`), at least its wall time. Intervals are in the
+//! injected clock's time (`Clock::now()`); fixed-capacity and allocation-free.
 
 use std::time::Duration;
 
@@ -21,6 +23,9 @@ pub struct GateSettings {
     /// Share of one core, in (0, 1].
     pub duty_cycle: f64,
     pub window: Duration,
+    /// Threads a plan runs on at once (at least 1): a plan of budget `b` may use up to
+    /// `threads x b` of core time.
+    pub threads: u32,
 }
 
 /// One finished plan: its wall-clock interval and the core time it used.
@@ -39,10 +44,8 @@ impl Spent {
         if b <= a {
             return 0.0;
         }
+        // `b > a` within `[start, end]`: the span is positive.
         let span = self.end.saturating_sub(self.start).as_secs_f64();
-        if span <= 0.0 {
-            return self.core.as_secs_f64();
-        }
         self.core.as_secs_f64() * (b - a).as_secs_f64() / span
     }
 }
@@ -93,25 +96,31 @@ impl ComputeGate {
         self.cap().saturating_sub(self.used(now))
     }
 
+    /// The most core time a plan of `budget` can use.
+    pub fn worst_case(&self, budget: Duration) -> Duration {
+        budget.saturating_mul(self.settings.threads.max(1))
+    }
+
     /// Whether a plan of `budget` may start at `now`.
     pub fn admits(&self, now: Duration, budget: Duration) -> bool {
         let spaced = self
             .last_start
             .is_none_or(|s| now >= s.saturating_add(self.settings.min_spacing));
-        spaced && self.used(now).saturating_add(budget) <= self.cap()
+        spaced && self.used(now).saturating_add(self.worst_case(budget)) <= self.cap()
     }
 
     /// The earliest time at or after `now` at which a plan of `budget` may start, if no
     /// other plan starts before; `None` if the budget alone exceeds the cap.
     pub fn earliest_start(&self, now: Duration, budget: Duration) -> Option<Duration> {
-        if budget > self.cap() {
+        let need = self.worst_case(budget);
+        if need > self.cap() {
             return None;
         }
         let spaced = match self.last_start {
             Some(s) => now.max(s.saturating_add(self.settings.min_spacing)),
             None => now,
         };
-        let fits = |t: Duration| self.used(t).saturating_add(budget) <= self.cap();
+        let fits = |t: Duration| self.used(t).saturating_add(need) <= self.cap();
         if fits(spaced) {
             return Some(spaced);
         }
@@ -164,7 +173,25 @@ mod tests {
             min_spacing: ms(200),
             duty_cycle: 0.5,
             window: ms(1000),
+            threads: 1,
         })
+    }
+
+    /// B5: a plan on two threads can use twice its budget of core time: it is admitted
+    /// only if twice its budget fits under the cap.
+    #[test]
+    fn admission_counts_every_thread_of_a_plan() {
+        let mut g = ComputeGate::new(GateSettings {
+            min_spacing: ms(0),
+            duty_cycle: 0.5,
+            window: ms(1000),
+            threads: 2,
+        });
+        assert!(g.admits(ms(0), ms(250)), "2 x 250 ms fits the 500 ms cap");
+        assert!(!g.admits(ms(0), ms(251)));
+        assert_eq!(g.earliest_start(ms(0), ms(300)), None, "600 ms never fits");
+        g.record(ms(0), ms(100), ms(200));
+        assert!(g.admits(ms(100), ms(150)) && !g.admits(ms(100), ms(151)));
     }
 
     #[test]

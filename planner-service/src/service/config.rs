@@ -41,7 +41,9 @@ pub struct ServiceConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BudgetConfig {
-    /// Deadline of a 2-D plan, ms. The plan commits this long after its trigger.
+    /// Deadline of a 2-D plan, ms. A re-plan commits this long after it starts (mission
+    /// time when it is started, which is later than its trigger if the compute gate
+    /// deferred it).
     pub plan_2d_ms: u64,
     /// Deadline of a 3-D plan, ms.
     pub plan_3d_ms: u64,
@@ -94,8 +96,12 @@ pub struct StatusConfig {
 pub struct SolverConfig {
     /// Seed of the particle swarm (same inputs and seed: same plan).
     pub seed: u64,
-    /// Worker threads of the particle swarm (the NLP runs on the solve thread alone).
-    pub swarm_threads: usize,
+    /// Threads a plan runs on: the particle swarm's workers, and the NLP starts solved
+    /// side by side (`PlannerSettings::threads`). 1 keeps planning on one core. The
+    /// duty-cycle cap counts a plan's budget once per thread. (`swarm_threads`, its old
+    /// name, is read too.)
+    #[serde(alias = "swarm_threads")]
+    pub threads: usize,
 }
 
 impl Default for ServiceConfig {
@@ -154,7 +160,7 @@ impl Default for SolverConfig {
     fn default() -> Self {
         SolverConfig {
             seed: 1,
-            swarm_threads: 2,
+            threads: 2,
         }
     }
 }
@@ -196,8 +202,14 @@ impl ServiceConfig {
             return bad("vehicle_id", e.to_string());
         }
         let b = &self.budget;
-        if b.plan_2d_ms == 0 || b.plan_3d_ms == 0 {
-            return bad("budget.plan_2d_ms", "plan budgets must be positive".into());
+        if b.plan_2d_ms == 0 {
+            return bad("budget.plan_2d_ms", "must be positive".into());
+        }
+        if b.plan_3d_ms == 0 {
+            return bad("budget.plan_3d_ms", "must be positive".into());
+        }
+        if self.solver.threads == 0 {
+            return bad("solver.threads", "must be at least 1".into());
         }
         if !(b.duty_cycle > 0.0 && b.duty_cycle <= 1.0) {
             return bad(
@@ -209,13 +221,15 @@ impl ServiceConfig {
             return bad("budget.duty_window_ms", "must be positive".into());
         }
         let cap_ms = b.duty_cycle * b.duty_window_ms as f64;
-        let largest = b.plan_2d_ms.max(b.plan_3d_ms) as f64;
+        let threads = self.solver.threads;
+        let largest = b.plan_2d_ms.max(b.plan_3d_ms) as f64 * threads as f64;
         if cap_ms < largest {
             return bad(
                 "budget.duty_cycle",
                 format!(
-                    "duty_cycle x duty_window_ms = {cap_ms} ms is less than one plan's budget \
-                     ({largest} ms): no plan could ever start"
+                    "duty_cycle x duty_window_ms = {cap_ms} ms is less than the core time one \
+                     plan may use (its budget x solver.threads {threads} = {largest} ms): no \
+                     plan could ever start"
                 ),
             );
         }
@@ -253,9 +267,6 @@ impl ServiceConfig {
         let s = &self.staleness;
         if s.lead_ms == 0 || s.ownship_ms == 0 || s.tracks_ms == 0 {
             return bad("staleness", "bounds must be positive".into());
-        }
-        if self.solver.swarm_threads == 0 {
-            return bad("solver.swarm_threads", "must be at least 1".into());
         }
         Ok(())
     }

@@ -343,7 +343,9 @@ impl MessageLoop {
         };
         let mut settings = PlannerSettings::default();
         settings.swarm = settings.swarm.with_seed(cfg.solver.seed);
-        settings.swarm.threads = cfg.solver.swarm_threads;
+        // One setting for both parallel stages: the swarm's workers and the NLP starts.
+        settings.swarm.threads = cfg.solver.threads;
+        settings.threads = cfg.solver.threads;
         let vehicle = cfg.vehicle_id.clone();
         let solver = Solver::spawn(
             settings,
@@ -354,6 +356,7 @@ impl MessageLoop {
             min_spacing: Duration::from_millis(cfg.budget.min_spacing_ms),
             duty_cycle: cfg.budget.duty_cycle,
             window: Duration::from_millis(cfg.budget.duty_window_ms),
+            threads: cfg.solver.threads.try_into().unwrap_or(u32::MAX),
         });
         let mut ml = MessageLoop {
             clock: options.clock,
