@@ -12,8 +12,15 @@
 //!    above is visible) and notifies `wake/harness`.
 //!
 //! It never plans itself. A pass allocates nothing of its own after start-up
-//! (`tests/service_no_alloc.rs`); iceoryx2 0.10 allocates a small block per loaned sample
-//! it publishes, freed on send.
+//! (`tests/service_no_alloc.rs`, with a tracing subscriber installed and `info` events
+//! filtered out), with these exceptions:
+//! - iceoryx2 0.10 allocates a small block per loaned sample it publishes, freed on send;
+//! - the first plan of a model after a plan of the other model: `World::fill_problem`
+//!   builds the other model's threat layout once (a `Vec` of moving threats);
+//! - log events that are enabled: `info!` on a trigger, a plan start or a plan published
+//!   (and `warn!`/`error!` on the paths that log) go through the installed subscriber,
+//!   and tracing-subscriber's formatter allocates while formatting a line. At
+//!   `RUST_LOG=warn` a steady pass logs nothing.
 //!
 //! Time. Mission time is the newest input header's `mission_time_ns`; the scheduled `t_r`,
 //! the expiry and the commit times are mission times, so they are evaluated whenever

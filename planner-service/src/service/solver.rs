@@ -179,17 +179,30 @@ impl Solver {
 }
 
 impl Drop for Solver {
+    /// Unblocks a pending send and joins the thread once the plan in hand has ended (by
+    /// its deadline), waiting at most [`DROP_WAIT`]; past it the thread is left to end
+    /// with the process.
     fn drop(&mut self) {
         self.requests = None;
         if let Some(thread) = self.thread.take() {
-            // Unblock a pending send, then join: the plan in hand ends by its deadline.
-            while !thread.is_finished() {
-                let _ = self.results.recv_timeout(Duration::from_millis(5));
+            let step = Duration::from_millis(5);
+            let mut waited = Duration::ZERO;
+            while !thread.is_finished() && waited < DROP_WAIT {
+                let _ = self.results.recv_timeout(step);
+                waited += step;
             }
-            let _ = thread.join();
+            if thread.is_finished() {
+                let _ = thread.join();
+            } else {
+                error!("the solve thread did not end within {DROP_WAIT:?}; not joined");
+            }
         }
     }
 }
+
+/// Longest wait for the solve thread when a [`Solver`] is dropped without
+/// [`Solver::shutdown`] (a plan ends by its deadline; budgets are seconds at most).
+pub const DROP_WAIT: Duration = Duration::from_secs(60);
 
 fn solve_loop(
     settings: &PlannerSettings,
@@ -202,12 +215,19 @@ fn solve_loop(
     let threads = settings.swarm.threads.max(settings.threads).max(1) as u32;
     for request in requests.iter() {
         let SolveRequest { problem, ticket } = request;
+        // The stage durations are recorded on the span when the plan ends (the planner
+        // reports them in `PlanOutcome::times`; seeding is part of the swarm stage).
         let span = info_span!(
             "plan",
             id = ticket.plan_id,
             trigger = ticket.trigger.name(),
             budget_ms = ticket.budget.as_millis() as u64,
             t0 = problem.t0,
+            swarm_ms = tracing::field::Empty,
+            nlp_ms = tracing::field::Empty,
+            export_ms = tracing::field::Empty,
+            total_ms = tracing::field::Empty,
+            cpu_ms = tracing::field::Empty,
         );
         let _entered = span.enter();
         let cpu_before = process_cpu_time();
@@ -228,6 +248,13 @@ fn solve_loop(
             (Some(a), Some(b)) => b.saturating_sub(a).max(wall),
             _ => wall * threads,
         };
+        span.record("cpu_ms", ms(core_time));
+        if let Ok(o) = &outcome {
+            span.record("swarm_ms", ms(o.times.swarm));
+            span.record("nlp_ms", ms(o.times.nlp));
+            span.record("export_ms", ms(o.times.export));
+            span.record("total_ms", ms(o.times.total));
+        }
         match &outcome {
             Ok(o) => info!(
                 quality = o.quality.name(),
