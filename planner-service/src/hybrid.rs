@@ -537,7 +537,7 @@ fn warm_start_of(solved: &Option<Solved>, enabled: bool) -> Option<(&Transcripti
 }
 
 /// Phase durations of a trajectory (at least one second each).
-fn phase_durations(t0: f64, tr: &Trajectory) -> Vec<f64> {
+pub fn phase_durations(t0: f64, tr: &Trajectory) -> Vec<f64> {
     let mut prev = t0;
     tr.phase_ends
         .iter()
