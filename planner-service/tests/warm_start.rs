@@ -11,25 +11,13 @@ use wingman_planner::collocation::{
     ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, Transcription, TranscriptionSettings,
     export, solve, transcription::INF,
 };
-use wingman_planner::hybrid::{Planner, PlannerSettings};
+use wingman_planner::hybrid::{Planner, PlannerSettings, phase_durations};
 use wingman_planner::problem::Problem;
 use wingman_planner::scenario::bundled;
 use wingman_planner::trajectory::Trajectory;
 
 fn clock() -> &'static MonotonicClock {
     Box::leak(Box::new(MonotonicClock::new()))
-}
-
-fn durations(p: &Problem, g: &Trajectory) -> Vec<f64> {
-    let mut prev = p.t0;
-    g.phase_ends
-        .iter()
-        .map(|&e| {
-            let d = e - prev;
-            prev = e;
-            d
-        })
-        .collect()
 }
 
 /// A converged solve of `name` on a uniform mesh of `points` per `interval_s`, started
@@ -45,7 +33,7 @@ fn converged(name: &str, points: usize, interval_s: f64) -> (Problem, Transcript
         )
         .unwrap();
     let guess = plan.trajectory;
-    let mesh = Mesh::uniform(points, &durations(&p, &guess), interval_s, 2);
+    let mesh = Mesh::uniform(points, &phase_durations(p.t0, &guess), interval_s, 2);
     let (tr, sol) = solve_from(&p, &mesh, &guess, None);
     (p, tr, sol.expect("the reference solve converges"))
 }
