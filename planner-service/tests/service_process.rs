@@ -1,6 +1,7 @@
 //! The real `wingman-planner serve` process:
 //!
-//! - SIGTERM stops it with exit code 0 after it has published its heartbeat;
+//! - SIGTERM stops it with exit code 0 after it has published its heartbeat, and with a
+//!   plan in flight after publishing that plan;
 //! - killed with SIGKILL (no clean-up), a new process on the same vehicle id starts (the
 //!   dead node's resources are removed at start-up), takes the tasking and threats from
 //!   the services' history, plans, and stops cleanly;
@@ -116,6 +117,45 @@ fn sigterm_stops_the_service_with_exit_code_0() {
     assert!(err.contains("planner service stopping"), "stderr:\n{err}");
 }
 
+/// T7: SIGTERM while a plan is in flight: the service finishes that plan, publishes it,
+/// then exits 0.
+#[test]
+fn sigterm_with_a_plan_in_flight_publishes_it_and_exits_0() {
+    let v = vehicle("sigterm-busy");
+    let config = config_file("sigterm-busy");
+    let planner = Planner::spawn(&v, &config);
+    let mut h = FakeHarness::new(&v);
+    assert!(
+        h.wait_until(Duration::from_secs(30), |h| h.status.is_some()),
+        "no heartbeat"
+    );
+    // A 3-D plan takes about a second in a release build.
+    let sc = bundled("3d-min-time-avoidable").unwrap().unwrap();
+    h.send_tasking(tasking_from(&sc, 1));
+    h.wake();
+    assert!(
+        h.wait_until(Duration::from_secs(30), |h| h
+            .status
+            .is_some_and(|s| s.state() == Some(PlannerState::Planning))),
+        "the plan did not start: {:?}",
+        h.status
+    );
+    planner.signal("-TERM");
+    let (status, err) = planner.wait(Duration::from_secs(60));
+    assert_eq!(status.code(), Some(0), "stderr:\n{err}");
+    let stopping = err
+        .find("planner service stopping")
+        .expect("stopping logged");
+    let published = err
+        .find("plan published")
+        .unwrap_or_else(|| panic!("the plan in flight was not published; stderr:\n{err}"));
+    assert!(
+        stopping < published,
+        "the plan was published after the signal, on the way out"
+    );
+    let _ = std::fs::remove_file(config);
+}
+
 #[test]
 fn a_restart_after_a_crash_cleans_up_and_takes_the_world_from_history() {
     let v = vehicle("restart");
@@ -154,8 +194,17 @@ fn a_restart_after_a_crash_cleans_up_and_takes_the_world_from_history() {
         "no heartbeat from the restarted planner: {:?}",
         h.status
     );
-    // The harness hands its history to the new subscribers, then wakes the planner.
+    // The harness hands its history to the new subscribers, sends the ownship state (it
+    // flies plan 1, 5 s into the mission), then wakes the planner.
     h.refresh();
+    let flown = h.plans[0].clone();
+    h.set_time(5.0);
+    let mut own = OwnshipState::zeroed();
+    own.time_s = 5.0;
+    own.model = Model::TwoD.to_wire();
+    own.plan_id = flown.plan_id;
+    own.state = wingman_planner::service::export::state_at(&flown, 5.0).unwrap();
+    h.send_ownship(own);
     h.wake();
     assert!(
         h.wait_until(Duration::from_secs(120), |h| h
@@ -168,9 +217,14 @@ fn a_restart_after_a_crash_cleans_up_and_takes_the_world_from_history() {
     );
     let s = h.last_status();
     assert_eq!(
-        s.messages_received, 5,
-        "4 threats and the tasking from history"
+        s.messages_received, 6,
+        "4 threats and the tasking from history, the ownship state"
     );
+    // T7: the mission is under way: a restart, from the ownship, with the next plan id.
+    let p = h.plans.last().unwrap();
+    assert_eq!(p.trigger(), Some(Trigger::Restart));
+    assert_eq!(p.plan_id, flown.plan_id + 1, "plan ids continue");
+    assert_eq!(s.current_plan_id, p.plan_id);
     assert_eq!(s.messages_rejected, 0);
     second.signal("-TERM");
     let (status, err) = second.wait(Duration::from_secs(30));
@@ -183,7 +237,9 @@ fn a_restart_after_a_crash_cleans_up_and_takes_the_world_from_history() {
 /// The `--flags` of a line of text (a command line, help text or prose).
 fn flags(line: &str) -> Vec<String> {
     line.split(|c: char| !(c.is_ascii_alphanumeric() || c == '-'))
-        .filter(|w| w.starts_with("--") && w.len() > 2)
+        .filter(|w| {
+            w.starts_with("--") && w.as_bytes().get(2).is_some_and(u8::is_ascii_alphanumeric)
+        })
         .map(str::to_string)
         .collect()
 }
@@ -216,17 +272,31 @@ fn the_unit_file_and_the_deployment_doc_match_the_binary() {
         "CPUQuota=",
         "MemoryMax=",
         "Restart=on-failure",
+        "RestartPreventExitStatus=2",
         "KillSignal=SIGTERM",
     ] {
         assert!(unit.contains(key), "the unit sets {key}");
     }
 
+    // T8: every flag the documents mention is one `serve` has, except on the lines of
+    // other commands (cargo, the install steps, systemd's tools).
     let doc = std::fs::read_to_string(repo().join("docs/DEPLOYMENT.md")).unwrap();
+    let toml = std::fs::read_to_string(repo().join("planner.toml")).unwrap();
+    let other = ["cargo ", "sudo ", "journalctl", "systemctl", "useradd"];
     let mut commands = 0;
-    for line in doc.lines().filter(|l| l.contains("wingman-planner serve")) {
-        commands += 1;
-        for f in flags(line) {
-            assert!(known.contains(&f), "DEPLOYMENT.md uses {f}: {line}");
+    for (file, text) in [
+        ("DEPLOYMENT.md", &doc),
+        ("planner.toml", &toml),
+        ("the unit", &unit),
+    ] {
+        for line in text.lines() {
+            commands += usize::from(line.contains("wingman-planner serve"));
+            if other.iter().any(|o| line.contains(o)) {
+                continue;
+            }
+            for f in flags(line) {
+                assert!(known.contains(&f), "{file} mentions {f}: {line}");
+            }
         }
     }
     assert!(commands > 0, "DEPLOYMENT.md shows how to run serve");
@@ -237,4 +307,18 @@ fn the_unit_file_and_the_deployment_doc_match_the_binary() {
         );
     }
     assert!(doc.contains("deploy/wingman-planner.service"));
+    // D3: the stop timeout exceeds the largest plan budget of planner.toml + 2 s.
+    let stop_s: f64 = unit
+        .lines()
+        .find_map(|l| l.strip_prefix("TimeoutStopSec="))
+        .expect("TimeoutStopSec")
+        .trim()
+        .parse()
+        .unwrap();
+    let cfg = wingman_planner::service::ServiceConfig::load(repo().join("planner.toml")).unwrap();
+    let largest_s = cfg.budget.plan_2d_ms.max(cfg.budget.plan_3d_ms) as f64 / 1e3;
+    assert!(
+        stop_s > largest_s + 2.0,
+        "TimeoutStopSec={stop_s} <= {largest_s} s + 2 s"
+    );
 }
