@@ -2,8 +2,10 @@
 //! allocator around [`MessageLoop::update`] and the status it composes — draining real
 //! iceoryx2 subscribers, validating every sample, updating the world (the Kalman filter
 //! of a moving threat included), assessing pop-ups against the plan, rescheduling `t_r`,
-//! rejecting invalid messages — over hundreds of passes; then around starting a re-plan
-//! and taking its result.
+//! rejecting invalid messages, a repeated tasking, a changed lead route — over hundreds
+//! of passes, with a tracing subscriber installed at `warn`; then around starting a
+//! re-plan for a pop-up and one for a deviation (checked not deferred by the gate), and
+//! taking their results.
 //!
 //! Publishing the status (and notifying the harness) allocates exactly one small block
 //! per sample inside iceoryx2 0.10 (`Publisher::loan_uninit` creates a shared-state `Arc`
@@ -86,6 +88,16 @@ fn send_step(h: &mut FakeHarness, i: usize) {
     bad.header = h.header();
     bad.axes_m[1] = -1.0;
     h.send_threat_raw(bad);
+    // A tasking repeating the held one under a new revision (no re-plan), and a lead
+    // route changed every step (it re-plans only a rendezvous).
+    let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();
+    h.send_tasking(tasking_from(&sc, 2 + i as u32));
+    let mut route = LeadRoute::zeroed();
+    route.revision = 1 + i as u32;
+    route.point_count = 2;
+    route.speed_mps = 150.0;
+    route.points_m[1] = [100000.0 + i as f64, 0.0, 0.0];
+    h.send_route(route);
 }
 
 #[test]
@@ -98,6 +110,12 @@ fn a_pass_of_the_message_loop_does_not_allocate() {
         handle_signals: false,
         shutdown: Shutdown::new(),
     };
+    // A subscriber as in the service (its formatter allocates for every line it writes):
+    // at `warn`, a steady pass writes none.
+    let _ = tracing_subscriber::fmt()
+        .with_max_level(tracing_subscriber::filter::LevelFilter::WARN)
+        .with_writer(std::io::sink)
+        .try_init();
     let mut ml = MessageLoop::new(&options).expect("message loop");
     let mut h = FakeHarness::new(&v);
 
@@ -144,10 +162,10 @@ fn a_pass_of_the_message_loop_does_not_allocate() {
         publishing <= passes,
         "{publishing} allocations publishing {passes} statuses (iceoryx2 makes one per loan)"
     );
-    // The passes did the work: 5 messages each, one rejected, one clear pop-up.
+    // The passes did the work: 7 messages each, one rejected, one clear pop-up.
     assert_eq!(
         after.messages_received - before.messages_received,
-        5 * passes as u64
+        7 * passes as u64
     );
     assert_eq!(
         after.messages_rejected - before.messages_rejected,
@@ -160,6 +178,8 @@ fn a_pass_of_the_message_loop_does_not_allocate() {
     // A pop-up on the plan: starting the re-plan (problem snapshot into the reused
     // buffers, request to the solve thread) allocates nothing either; taking the result
     // and publishing the plan allocates only iceoryx2's loan.
+    // Past the gate's spacing, so that the plan starts in this pass (not deferred).
+    std::thread::sleep(Duration::from_millis(300));
     let on = state_at(&h.plans[0], 200.0).unwrap();
     h.send_threat(static_threat(
         72,
@@ -167,12 +187,56 @@ fn a_pass_of_the_message_loop_does_not_allocate() {
         [1500.0, 1500.0, 0.0],
     ));
     let starting = allocations_in(|| assert!(ml.update()));
-    assert_eq!(ml.status_message().state(), Some(PlannerState::Planning));
+    let s = ml.status_message();
+    assert_eq!(s.state(), Some(PlannerState::Planning));
+    assert_eq!(
+        s.triggers_deferred, before.triggers_deferred,
+        "the plan started in the pass measured, not deferred"
+    );
     assert_eq!(starting, 0, "allocations starting a plan");
+    take_plan(&mut ml, 2);
+
+    // A deviation: a re-plan from the ownship's dead-reckoned state, started allocation
+    // free too.
+    std::thread::sleep(Duration::from_millis(300));
+    let t = 20.0 + 0.05 * (20 + passes) as f64;
+    h.set_time(t);
+    let mut own = OwnshipState::zeroed();
+    own.time_s = t;
+    own.model = Model::TwoD.to_wire();
+    own.plan_id = 2;
+    own.state = [
+        3000.0,
+        200.0 * t,
+        std::f64::consts::FRAC_PI_2,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ];
+    own.cross_track_m = -3000.0;
+    h.send_ownship(own);
+    let before = ml.status_message();
+    let starting = allocations_in(|| assert!(ml.update()));
+    let s = ml.status_message();
+    assert_eq!(s.state(), Some(PlannerState::Planning));
+    assert_eq!(s.triggers_deferred, before.triggers_deferred);
+    assert_eq!(starting, 0, "allocations starting a deviation re-plan");
+    take_plan(&mut ml, 3);
+    let p = {
+        h.poll();
+        h.plans.last().unwrap().clone()
+    };
+    assert_eq!(p.trigger(), Some(Trigger::Deviation));
+}
+
+/// Passes until plan `n` is taken; taking and publishing it allocates only iceoryx2's
+/// loan.
+fn take_plan(ml: &mut MessageLoop, n: u64) {
     let start = Instant::now();
     let mut taking = 0;
-    while ml.status_message().plans_made < 2 {
-        assert!(start.elapsed() < Duration::from_secs(120), "no re-plan");
+    while ml.status_message().plans_made < n {
+        assert!(start.elapsed() < Duration::from_secs(120), "no plan {n}");
         std::thread::sleep(Duration::from_millis(5));
         taking += allocations_in(|| {
             ml.update();
@@ -180,6 +244,6 @@ fn a_pass_of_the_message_loop_does_not_allocate() {
     }
     assert!(
         taking <= 1,
-        "{taking} allocations taking and publishing a plan"
+        "{taking} allocations taking and publishing plan {n}"
     );
 }
