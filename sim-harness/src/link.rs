@@ -123,6 +123,11 @@ impl PlannerLink {
         self.last_status.as_ref()
     }
 
+    /// Forgets the newest status (a new planner process is starting: wait for its own).
+    pub fn forget_status(&mut self) {
+        self.last_status = None;
+    }
+
     fn next_header(&mut self) -> Header {
         self.sequence += 1;
         Header::new(

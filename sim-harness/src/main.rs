@@ -80,6 +80,20 @@ struct FlyArgs {
     /// No progress line.
     #[arg(long)]
     quiet: bool,
+    /// Fault injection (tests): SIGKILL the spawned planner at this mission time, fly on
+    /// the last plan without it for --restart-after seconds, then start a new planner.
+    #[arg(long, value_name = "S")]
+    kill_planner_at: Option<f64>,
+    /// Mission time without a planner after --kill-planner-at, s.
+    #[arg(long, value_name = "S", default_value_t = 10.0)]
+    restart_after: f64,
+    /// Fault injection (tests): from this mission time, send a burst of
+    /// --popup-burst-count pop-ups within one second, on the flown plan ahead.
+    #[arg(long, value_name = "S")]
+    popup_burst_at: Option<f64>,
+    /// Pop-up reports in the burst.
+    #[arg(long, value_name = "N", default_value_t = 100)]
+    popup_burst_count: u32,
 }
 
 fn main() -> ExitCode {
@@ -177,6 +191,28 @@ fn apply(args: &FlyArgs, opts: &mut FlyOptions) -> Result<(), String> {
         ));
     }
     opts.time_limit_s = args.time_limit;
+    for (flag, v) in [
+        ("--kill-planner-at", args.kill_planner_at),
+        ("--restart-after", Some(args.restart_after)),
+        ("--popup-burst-at", args.popup_burst_at),
+    ] {
+        if let Some(v) = v
+            && !(v.is_finite() && v >= 0.0)
+        {
+            return Err(format!(
+                "{flag} must be a finite, non-negative time, got {v}"
+            ));
+        }
+    }
+    if args.kill_planner_at.is_some() && args.planner == "external" {
+        return Err("--kill-planner-at needs a spawned planner (not --planner external)".into());
+    }
+    opts.faults = mission::Faults {
+        kill_planner_at_s: args.kill_planner_at,
+        restart_after_s: args.restart_after,
+        popup_burst_at_s: args.popup_burst_at,
+        popup_burst_count: args.popup_burst_count,
+    };
     if let Some(path) = &args.planner_config {
         opts.planner_config = ServiceConfig::load(path).map_err(|e| e.to_string())?;
     }

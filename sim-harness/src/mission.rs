@@ -6,7 +6,9 @@ use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use wingman_interfaces::{Model, PlannerStatus, Quality, Trigger};
+use wingman_interfaces::{
+    Model, PlannerStatus, Quality, ThreatKind, ThreatReport, Trigger, Wire, threat_name,
+};
 use wingman_planner::estimation::{Estimate, GaussMarkov, KalmanFilter, Road};
 use wingman_planner::problem::{Problem, ProblemError};
 use wingman_planner::scenario::Scenario;
@@ -51,6 +53,66 @@ pub struct FlyOptions {
     pub planner_timeout: Duration,
     /// Print a progress line on stderr.
     pub progress: bool,
+    /// Faults injected into the flight (fault-tolerance tests); none by default.
+    pub faults: Faults,
+}
+
+/// Faults the harness can inject into a flight, for the fault-tolerance tests of
+/// `tests/tests/faults.rs` (`fly --kill-planner-at`, `--popup-burst-at`). None by default.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Faults {
+    /// SIGKILL the spawned planner at this mission time (no clean-up: its iceoryx2
+    /// resources stay behind), fly on without a planner for [`Faults::restart_after_s`]
+    /// (the tracker keeps flying the last plan; the lock-step clock does not wait), then
+    /// start a new planner process on the same vehicle id, its log in
+    /// `planner.restart.log`. The new planner must clean up the dead node and take the
+    /// world from the services' history.
+    pub kill_planner_at_s: Option<f64>,
+    /// Mission time without a planner after the kill, s.
+    pub restart_after_s: f64,
+    /// From this mission time on, over one second of mission time, send
+    /// [`Faults::popup_burst_count`] static pop-up reports centred on the flown plan 60 s
+    /// ahead (4 threat ids re-reported at new places, 300 m radius). They are not part of
+    /// the scenario's truth, so the report's metrics do not count them.
+    pub popup_burst_at_s: Option<f64>,
+    /// Pop-up reports in the burst.
+    pub popup_burst_count: u32,
+}
+
+impl Default for Faults {
+    fn default() -> Self {
+        Faults {
+            kill_planner_at_s: None,
+            restart_after_s: 10.0,
+            popup_burst_at_s: None,
+            popup_burst_count: 100,
+        }
+    }
+}
+
+/// First threat id of the burst's pop-ups (clear of the scenario's ids).
+const BURST_ID_BASE: u32 = 1000;
+/// Threat ids the burst cycles through.
+const BURST_IDS: u32 = 4;
+
+/// The `k`-th pop-up of a burst of `count`, sent at `t`, centred on `plan` 60 s ahead
+/// (spread along it by the pop-up's rank).
+fn burst_popup(plan: &wingman_interfaces::Plan, t: f64, k: u32, count: u32) -> ThreatReport {
+    let ahead = t + 60.0 + 20.0 * f64::from(k) / f64::from(count.max(1));
+    let (x, _) = crate::tracker::reference(plan, ahead);
+    let model = plan.model().unwrap_or(Model::TwoD);
+    let mut r = ThreatReport::zeroed();
+    r.threat_id = BURST_ID_BASE + k % BURST_IDS;
+    r.kind = ThreatKind::Static.to_wire();
+    r.name = threat_name(&format!("burst-{}", k % BURST_IDS));
+    r.appeared_at_s = t;
+    r.center_m = position(model, &x);
+    r.axes_m = match model {
+        Model::TwoD => [300.0, 300.0, 0.0],
+        Model::ThreeD => [300.0, 300.0, 300.0],
+    };
+    r.exponents = [2.0, 2.0, 2.0];
+    r
 }
 
 impl FlyOptions {
@@ -69,6 +131,7 @@ impl FlyOptions {
             time_limit_s: None,
             planner_timeout: Duration::from_secs(300),
             progress: true,
+            faults: Faults::default(),
         }
     }
 }
@@ -302,11 +365,86 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
     let mut time_limit = opts.time_limit_s.unwrap_or(t0 + 7200.0);
     let mut k: u64 = 0;
     let mut t = t0;
+    let faults = &opts.faults;
+    let mut killed = false;
+    // Mission time at which a killed planner is started again.
+    let mut restart_at: Option<f64> = None;
+    let mut burst_sent: u32 = 0;
 
     let end = loop {
+        // 0. Injected faults: the planner killed, then started again.
+        if let Some(at) = faults.kill_planner_at_s
+            && !killed
+            && t >= at
+            && let Some(p) = planner.as_mut()
+        {
+            tracing::info!(
+                pid = p.id(),
+                mission_s = t,
+                "fault: planner killed (SIGKILL)"
+            );
+            p.kill();
+            killed = true;
+            restart_at = Some(t + faults.restart_after_s);
+        }
+        if let Some(at) = restart_at
+            && t >= at
+            && let PlannerMode::Spawn { binary } = &opts.planner
+        {
+            let bin = match binary {
+                Some(b) => b.clone(),
+                None => planner_binary()?,
+            };
+            let p = PlannerProcess::spawn(
+                &bin,
+                &config_path,
+                &vehicle,
+                &opts.out_dir.join("planner.restart.log"),
+            )?;
+            tracing::info!(pid = p.id(), mission_s = t, "fault: planner started again");
+            planner = Some(p);
+            restart_at = None;
+            // As at start-up: its inputs count once it is up (subscribed), which its
+            // first heartbeat tells.
+            link.forget_status();
+            let up = Instant::now();
+            while link.status().is_none() {
+                link.poll()?;
+                if planner.as_mut().is_some_and(|p| !p.is_running()) {
+                    return Err(FlyError::Planner(
+                        "the restarted planner exited at start-up".into(),
+                    ));
+                }
+                if up.elapsed() > Duration::from_secs(30) {
+                    return Err(FlyError::Planner(
+                        "no status from the restarted planner within 30 s".into(),
+                    ));
+                }
+                // No `refresh()` here: the history (tasking, threats) reaches the new
+                // planner with this step's ownship state, so it plans from where the
+                // aircraft is (`Restart`), not from the tasking's start.
+                link.wait(Duration::from_millis(100))?;
+            }
+        }
+        let planner_down = restart_at.is_some();
+
         // 1. This step's inputs.
         link.set_time(t);
         link.refresh();
+        if let Some(at) = faults.popup_burst_at_s
+            && t >= at
+            && burst_sent < faults.popup_burst_count
+            && let Some(flying) = tracker.flying()
+        {
+            // One second of mission time: the same share of the burst at every step.
+            let steps = (1.0 / dt).round().max(1.0) as u32;
+            let per_step = faults.popup_burst_count.div_ceil(steps);
+            for _ in 0..per_step.min(faults.popup_burst_count - burst_sent) {
+                let r = burst_popup(&flying.plan, t, burst_sent, faults.popup_burst_count);
+                link.send_threat(r)?;
+                burst_sent += 1;
+            }
+        }
         for out in sensor.poll(t) {
             match out {
                 SensorOutput::Report(r) => {
@@ -341,7 +479,7 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
         // 2. The planner's answer: lock-step waits for it.
         // Every clock waits for the first plan at take-off (it is planned before the
         // flight); the paced clocks start after it.
-        let received: Received = if opts.clock.is_lock_step() || k == 0 {
+        let received: Received = if (opts.clock.is_lock_step() || k == 0) && !planner_down {
             let (r, ok) = link.sync(opts.planner_timeout, || {
                 planner.as_mut().is_none_or(|p| p.is_running())
             })?;

@@ -105,6 +105,14 @@ impl PlannerProcess {
         }
     }
 
+    /// SIGKILL (no clean-up, as a crash), and reaps it.
+    pub fn kill(&mut self) {
+        if let Some(mut c) = self.child.take() {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+
     /// SIGTERM, then waits up to `grace`; kills it if it is still running then.
     pub fn stop(&mut self, grace: Duration) -> Option<ExitStatus> {
         let mut child = self.child.take()?;

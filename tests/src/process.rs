@@ -146,11 +146,17 @@ pub fn text(o: &Output) -> String {
     )
 }
 
-/// `wingman-harness <args>` with its output captured (`RUST_LOG=warn`).
+/// `wingman-harness <args>` with its output captured (`RUST_LOG=warn`, which a spawned
+/// planner inherits).
 pub fn harness(args: &[&str]) -> Proc {
+    harness_logging(args, "warn")
+}
+
+/// `wingman-harness <args>` with its output captured, at log level `rust_log`.
+pub fn harness_logging(args: &[&str], rust_log: &str) -> Proc {
     let mut c = Command::new(binary("wingman-harness"));
     c.args(args)
-        .env("RUST_LOG", "warn")
+        .env("RUST_LOG", rust_log)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     Proc::spawn(c, "wingman-harness")
