@@ -308,7 +308,7 @@ pub struct MessageLoop {
     deviation_fired_for: u64,
     expiry_fired_for: u64,
     scheduled_fired_for: u64,
-    logged_rejections: [[bool; 7]; Input::COUNT],
+    logged_rejections: [[bool; REJECTION_KINDS]; Input::COUNT],
     logged_receive_errors: [bool; Input::COUNT],
     logged_plan_id: bool,
     logged_fix_refused: bool,
@@ -393,7 +393,7 @@ impl MessageLoop {
             deviation_fired_for: 0,
             expiry_fired_for: 0,
             scheduled_fired_for: 0,
-            logged_rejections: [[false; 7]; Input::COUNT],
+            logged_rejections: [[false; REJECTION_KINDS]; Input::COUNT],
             logged_receive_errors: [false; Input::COUNT],
             logged_plan_id: false,
             logged_fix_refused: false,
@@ -1138,6 +1138,10 @@ impl MessageLoop {
     fn accept(&mut self, o: &PlanOutcome, ticket: &Ticket, compute_ms: f64) {
         // The model and speed of the problem planned (the tasking may have changed since).
         let Some((model, speed)) = self.problem.as_ref().map(|p| (p.model, p.limits.speed)) else {
+            error!(
+                trigger = ticket.trigger.name(),
+                "the problem buffers are missing: the plan made is dropped"
+            );
             return;
         };
         let info = PlanInfo {
@@ -1317,7 +1321,11 @@ fn dead_reckon(o: &OwnshipState, t: &Tasking, at: f64) -> Option<[f64; 7]> {
     Some(x)
 }
 
-/// Index of a validation error's kind (for logging once per kind).
+/// Kinds of [`ValidationError`] ([`rejection_index`] maps each to one below this).
+const REJECTION_KINDS: usize = 7;
+
+/// Index of a validation error's kind (for logging once per kind), below
+/// [`REJECTION_KINDS`]. The match is exhaustive: a new kind fails to compile here.
 fn rejection_index(e: &ValidationError) -> usize {
     match e {
         ValidationError::ProtocolVersion { .. } => 0,
