@@ -31,41 +31,12 @@ use wingman_planner::service::{MessageLoop, RunOptions, Shutdown};
 mod counting_alloc;
 use counting_alloc::allocations_in;
 
-/// A moving threat on a road far north of the plan, driving east at 10 m/s.
-fn moving_threat(id: u32) -> ThreatReport {
-    let mut r = ThreatReport::zeroed();
-    r.threat_id = id;
-    r.kind = ThreatKind::Moving.to_wire();
-    r.axes_m = [3000.0, 1500.0, 0.0];
-    r.road_point_count = 2;
-    r.road_m[0] = [-60000.0, 120000.0, 0.0];
-    r.road_m[1] = [60000.0, 120000.0, 0.0];
-    r.estimate_time_s = 0.0;
-    r.estimate_mean = [1000.0, 10.0, 0.0];
-    r.estimate_covariance = [250000.0, 0.0, 0.0, 0.0, 4.0, 0.0, 0.0, 0.0, 0.01];
-    r.accel_sigma_mps2 = 0.2;
-    r.accel_tau_s = 30.0;
-    r
-}
-
 /// One step of inputs: ownship, lead state, a track fix, a pop-up clear of the plan
 /// (moved a little every time, so it is assessed again), an invalid message.
 fn send_step(h: &mut FakeHarness, i: usize) {
     let t = 20.0 + 0.05 * i as f64;
     h.set_time(t);
-    let mut own = OwnshipState::zeroed();
-    own.time_s = t;
-    own.model = Model::TwoD.to_wire();
-    own.plan_id = 1;
-    own.state = [
-        0.0,
-        200.0 * t,
-        std::f64::consts::FRAC_PI_2,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-    ];
+    let mut own = ownship_2d(t, 1, [0.0, 200.0 * t, std::f64::consts::FRAC_PI_2]);
     own.cross_track_m = 12.0;
     own.along_track_m = -3.0;
     h.send_ownship(own);
@@ -201,19 +172,7 @@ fn a_pass_of_the_message_loop_does_not_allocate() {
     std::thread::sleep(Duration::from_millis(300));
     let t = 20.0 + 0.05 * (20 + passes) as f64;
     h.set_time(t);
-    let mut own = OwnshipState::zeroed();
-    own.time_s = t;
-    own.model = Model::TwoD.to_wire();
-    own.plan_id = 2;
-    own.state = [
-        3000.0,
-        200.0 * t,
-        std::f64::consts::FRAC_PI_2,
-        0.0,
-        0.0,
-        0.0,
-        0.0,
-    ];
+    let mut own = ownship_2d(t, 2, [3000.0, 200.0 * t, std::f64::consts::FRAC_PI_2]);
     own.cross_track_m = -3000.0;
     h.send_ownship(own);
     let before = ml.status_message();

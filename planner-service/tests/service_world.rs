@@ -2,6 +2,8 @@
 //! limits, a threat changing kind, a track fix the filter refuses. Each test names the
 //! protection it checks; each fails without it.
 
+mod service_support;
+
 use std::time::Duration;
 
 use wingman_interfaces::*;
@@ -19,19 +21,12 @@ fn static_report(id: u32, x: f64) -> ThreatReport {
     r
 }
 
+/// A moving threat of `service_support`, its estimate at 10 s and a little different
+/// per id.
 fn moving_report(id: u32) -> ThreatReport {
-    let mut r = ThreatReport::zeroed();
-    r.threat_id = id;
-    r.kind = ThreatKind::Moving.to_wire();
-    r.axes_m = [3000.0, 1500.0, 0.0];
-    r.road_point_count = 2;
-    r.road_m[0] = [-60000.0, 120000.0, 0.0];
-    r.road_m[1] = [60000.0, 120000.0, 0.0];
+    let mut r = service_support::moving_threat(id);
     r.estimate_time_s = 10.0;
-    r.estimate_mean = [1000.0 + id as f64, 10.0, 0.0];
-    r.estimate_covariance = [250000.0, 0.0, 0.0, 0.0, 4.0, 0.0, 0.0, 0.0, 0.01];
-    r.accel_sigma_mps2 = 0.2;
-    r.accel_tau_s = 30.0;
+    r.estimate_mean[0] += id as f64;
     r
 }
 

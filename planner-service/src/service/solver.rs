@@ -161,20 +161,24 @@ impl Solver {
         let Some(thread) = self.thread.take() else {
             return;
         };
-        let step = Duration::from_millis(5);
-        let mut waited = Duration::ZERO;
-        while !thread.is_finished() && waited < timeout {
-            // Drain results so the thread is never blocked sending one.
-            let _ = self.results.recv_timeout(step);
-            waited += step;
-        }
-        if thread.is_finished() {
-            let _ = thread.join();
-        } else {
-            error!(
-                "the solve thread did not end within {timeout:?}; leaving it to the process exit"
-            );
-        }
+        join_within(thread, &self.results, timeout);
+    }
+}
+
+/// Joins the solve thread once it has ended, waiting at most `timeout` and draining its
+/// results meanwhile (so it is never blocked sending one); past it the thread is left to
+/// end with the process.
+fn join_within(thread: JoinHandle<()>, results: &Receiver<SolveResult>, timeout: Duration) {
+    let step = Duration::from_millis(5);
+    let mut waited = Duration::ZERO;
+    while !thread.is_finished() && waited < timeout {
+        let _ = results.recv_timeout(step);
+        waited += step;
+    }
+    if thread.is_finished() {
+        let _ = thread.join();
+    } else {
+        error!("the solve thread did not end within {timeout:?}; leaving it to the process exit");
     }
 }
 
@@ -185,17 +189,7 @@ impl Drop for Solver {
     fn drop(&mut self) {
         self.requests = None;
         if let Some(thread) = self.thread.take() {
-            let step = Duration::from_millis(5);
-            let mut waited = Duration::ZERO;
-            while !thread.is_finished() && waited < DROP_WAIT {
-                let _ = self.results.recv_timeout(step);
-                waited += step;
-            }
-            if thread.is_finished() {
-                let _ = thread.join();
-            } else {
-                error!("the solve thread did not end within {DROP_WAIT:?}; not joined");
-            }
+            join_within(thread, &self.results, DROP_WAIT);
         }
     }
 }

@@ -392,3 +392,20 @@ pub fn ownship_2d(t: f64, plan_id: u64, state: [f64; 3]) -> OwnshipState {
     o.state[..3].copy_from_slice(&state);
     o
 }
+
+/// A moving threat on a road far north of the plan, driving east at 10 m/s.
+pub fn moving_threat(id: u32) -> ThreatReport {
+    let mut r = ThreatReport::zeroed();
+    r.threat_id = id;
+    r.kind = ThreatKind::Moving.to_wire();
+    r.axes_m = [3000.0, 1500.0, 0.0];
+    r.road_point_count = 2;
+    r.road_m[0] = [-60000.0, 120000.0, 0.0];
+    r.road_m[1] = [60000.0, 120000.0, 0.0];
+    r.estimate_time_s = 0.0;
+    r.estimate_mean = [1000.0, 10.0, 0.0];
+    r.estimate_covariance = [250000.0, 0.0, 0.0, 0.0, 4.0, 0.0, 0.0, 0.0, 0.01];
+    r.accel_sigma_mps2 = 0.2;
+    r.accel_tau_s = 30.0;
+    r
+}
