@@ -96,6 +96,14 @@ impl<'c> Deadline<'c> {
         Deadline::after(self.clock, part)
     }
 
+    /// This deadline moved `by` earlier (time kept in reserve for the work after it).
+    pub fn earlier(&self, by: Duration) -> Deadline<'c> {
+        Deadline {
+            clock: self.clock,
+            at: self.at.saturating_sub(by),
+        }
+    }
+
     /// The clock this deadline runs on.
     pub fn clock(&self) -> &'c dyn Clock {
         self.clock
@@ -118,5 +126,19 @@ mod tests {
         clock.advance(Duration::from_millis(4));
         assert!(d.expired());
         assert_eq!(d.remaining(), Duration::ZERO);
+    }
+
+    #[test]
+    fn an_earlier_deadline_expires_first() {
+        let clock = ManualClock::new();
+        let d = Deadline::after(&clock, Duration::from_millis(10));
+        let e = d.earlier(Duration::from_millis(3));
+        assert_eq!(e.remaining(), Duration::from_millis(7));
+        clock.advance(Duration::from_millis(7));
+        assert!(e.expired() && !d.expired());
+        assert!(
+            d.earlier(Duration::from_secs(1)).expired(),
+            "saturates at zero"
+        );
     }
 }

@@ -169,6 +169,9 @@ pub struct PlanOutcome {
 /// The planner with its reusable workspace.
 pub struct Planner {
     swarm: SwarmWorkspace,
+    /// Per model (2-D, 3-D): about the longest time an NLP solve took to end its first
+    /// iteration in recent plans. A solve is not started with less time left.
+    setup: [Duration; 2],
 }
 
 /// One NLP solve's accepted result.
@@ -197,14 +200,13 @@ struct MeshSolve<'a> {
     feasibility_tol: f64,
     /// The previous mesh's transcription and primal-dual solution, to start from.
     warm_from: Option<(&'a Transcription, &'a PrimalDual)>,
+    /// Do not start with less time than this left.
+    min_time: Duration,
 }
 
 /// Solves `job.problem` on `job.mesh` from `job.guess`; `None` if the result is not
 /// feasible.
-fn solve_on_mesh(
-    job: MeshSolve<'_>,
-    deadline: Deadline<'static>,
-) -> Result<(Option<Solved>, usize, NlpStatus), PlanError> {
+fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult {
     let MeshSolve {
         problem,
         mesh,
@@ -214,10 +216,12 @@ fn solve_on_mesh(
         refined,
         feasibility_tol,
         warm_from,
+        min_time,
     } = job;
-    if deadline.expired() {
-        // No time: do not even build the NLP (the caller returns what it has).
-        return Ok((None, 0, NlpStatus::MaxTime));
+    if deadline.remaining() <= min_time {
+        // No time for even one iteration (the longest set-up and first iteration of the
+        // last plan): do not build the NLP; the caller returns what it has.
+        return Ok((None, 0, NlpStatus::MaxTime, None));
     }
     let mut tr = Transcription::new(problem, mesh, guess, &settings.transcription);
     let mut x = vec![0.0; tr.n_vars()];
@@ -251,10 +255,12 @@ fn solve_on_mesh(
         status: out.status,
         warm: out.warm,
     });
-    Ok((solved, out.iterations, out.status))
+    Ok((solved, out.iterations, out.status, out.first_iteration))
 }
 
-type SolveResult = Result<(Option<Solved>, usize, NlpStatus), PlanError>;
+/// A mesh solve's accepted result (if any), iterations, status and time to its first
+/// iteration's end.
+type SolveResult = Result<(Option<Solved>, usize, NlpStatus, Option<Duration>), PlanError>;
 
 /// Runs `job(i)` for `i in 0..n` on up to `threads` threads; results in index order.
 /// Each thread takes the next unstarted job when it finishes one (solves differ in length
@@ -294,7 +300,7 @@ fn in_parallel(
         }
         slots
             .into_iter()
-            .map(|r| r.unwrap_or(Ok((None, 0, NlpStatus::NumericalError))))
+            .map(|r| r.unwrap_or(Ok((None, 0, NlpStatus::NumericalError, None))))
             .collect()
     })
 }
@@ -303,6 +309,7 @@ impl Planner {
     pub fn new(settings: &PlannerSettings) -> Planner {
         Planner {
             swarm: SwarmWorkspace::new(&settings.swarm),
+            setup: [Duration::ZERO; 2],
         }
     }
 
@@ -333,7 +340,24 @@ impl Planner {
         }
         let swarm_cost = trajectory_cost(problem, &sw.best);
 
+        // The swarm's lifted path, flown with the tracking law so that its controls replay
+        // onto it (in 3-D the lifted controls alone drift away): the answer if the NLP
+        // does not finish. It is built now, so that at the deadline nothing is left to do
+        // but return it, and timed: exporting the NLP's plan costs about as much, so the
+        // NLP stops twice that long before the deadline.
+        let fallback_started = clock.now();
+        let mut fallback = sw.best.resampled(settings.export.max_step_s);
+        if problem.dim() == 3 {
+            fly(problem, &settings.export, &mut fallback);
+        }
+        let fallback_cost = clock.now().saturating_sub(fallback_started);
+        let deadline = deadline.earlier(fallback_cost * 2);
+
         let nlp_started = clock.now();
+        let model = usize::from(problem.dim() == 3);
+        let min_time = self.setup[model];
+        // The longest time to a first iteration among this plan's solves.
+        let mut setup = Duration::ZERO;
         let mut report = NlpReport {
             status: None,
             iterations: Vec::new(),
@@ -375,6 +399,7 @@ impl Planner {
                     refined: false,
                     feasibility_tol: settings.ranking_feasibility_tol,
                     warm_from: None,
+                    min_time,
                 },
                 deadline,
             )
@@ -387,7 +412,8 @@ impl Planner {
         };
         let mut coarse_solved: Vec<Option<Solved>> = Vec::with_capacity(ranked.len());
         for (i, r) in ranked.into_iter().enumerate() {
-            let (solved, iterations, status) = r?;
+            let (solved, iterations, status, first) = r?;
+            setup = setup.max(first.unwrap_or_default());
             report.iterations.push(iterations);
             report.status = Some(status);
             coarse_solved.push(None);
@@ -437,6 +463,7 @@ impl Planner {
                     warm_from: coarse_solved
                         .get(order[i].1)
                         .and_then(|s| warm_start_of(s, warm)),
+                    min_time,
                 },
                 deadline,
             )
@@ -445,7 +472,8 @@ impl Planner {
         let mut accepted: Option<Solved> = None;
         let mut mesh = fine[0].clone();
         for (i, r) in finals.into_iter().enumerate() {
-            let (solved, iterations, status) = r?;
+            let (solved, iterations, status, first) = r?;
+            setup = setup.max(first.unwrap_or_default());
             report.iterations.push(iterations);
             report.status = Some(status);
             if let Some(s) = solved
@@ -469,7 +497,7 @@ impl Planner {
                 break;
             };
             export(&current.tr, &current.x, &reference, &mut guess);
-            let (solved, iterations, status) = solve_on_mesh(
+            let (solved, iterations, status, _) = solve_on_mesh(
                 MeshSolve {
                     problem,
                     mesh: &next,
@@ -479,6 +507,7 @@ impl Planner {
                     refined: true,
                     feasibility_tol: settings.nlp.feasibility_tol,
                     warm_from: warm_start_of(&accepted, warm),
+                    min_time,
                 },
                 deadline,
             )?;
@@ -499,6 +528,13 @@ impl Planner {
             let _ = a.iterations;
         }
         times.nlp = clock.now().saturating_sub(nlp_started);
+        // Remember the set-up time, forgetting older, slower plans slowly (and retrying
+        // after plans that had no time to start a solve at all).
+        self.setup[model] = if setup > Duration::ZERO {
+            setup.max(self.setup[model] / 2)
+        } else {
+            self.setup[model].mul_f64(0.9)
+        };
 
         let export_started = clock.now();
         let (quality, trajectory) = match &accepted {
@@ -507,20 +543,12 @@ impl Planner {
                 export(&a.tr, &a.x, &settings.export, &mut flown);
                 (a.quality, flown)
             }
-            None => {
-                // The swarm's lifted path, flown with the tracking law so that its
-                // controls replay onto it (in 3-D the lifted controls alone drift away).
-                let mut flown = sw.best.resampled(settings.export.max_step_s);
-                if problem.dim() == 3 {
-                    fly(problem, &settings.export, &mut flown);
-                }
-                (Quality::SwarmOnly, flown)
-            }
+            None => (Quality::SwarmOnly, fallback),
         };
         if !trajectory.is_valid() {
             return Err(PlanError::NonFinite);
         }
-        times.export = clock.now().saturating_sub(export_started);
+        times.export = clock.now().saturating_sub(export_started) + fallback_cost;
         times.total = clock.now().saturating_sub(started);
         Ok(PlanOutcome {
             quality,

@@ -133,6 +133,8 @@ pub struct NlpOutcome {
     /// Primal-dual solution for a warm start (when the solver finished normally).
     pub warm: Option<PrimalDual>,
     pub elapsed: Duration,
+    /// Time from the start to the end of the first iteration (`None`: none ended).
+    pub first_iteration: Option<Duration>,
 }
 
 /// The TNLP adapter: owns the transcription during the solve.
@@ -148,6 +150,14 @@ struct Adapter {
     has_best: bool,
     solution: Option<PrimalDual>,
     iterations: usize,
+    /// When the solve began, and when the last iteration ended (deadline clock).
+    began: Duration,
+    last_iteration_end: Duration,
+    /// Time to the first iteration's end (set-up, ordering, initial multipliers).
+    first_iteration: Option<Duration>,
+    /// The longest iteration so far: a solve that has less time left stops now rather
+    /// than one iteration past its deadline.
+    longest_iteration: Duration,
 }
 
 impl TNLP for Adapter {
@@ -275,7 +285,15 @@ impl TNLP for Adapter {
                 self.best_objective = stats.obj_value;
             }
         }
-        !self.deadline.expired()
+        let now = self.deadline.clock().now();
+        if self.first_iteration.is_none() {
+            self.first_iteration = Some(now.saturating_sub(self.began));
+        } else {
+            let took = now.saturating_sub(self.last_iteration_end);
+            self.longest_iteration = self.longest_iteration.max(took);
+        }
+        self.last_iteration_end = now;
+        self.deadline.remaining() > self.longest_iteration
     }
 }
 
@@ -437,6 +455,10 @@ pub fn solve(
         has_best: false,
         solution: None,
         iterations: 0,
+        began,
+        last_iteration_end: began,
+        first_iteration: None,
+        longest_iteration: Duration::ZERO,
     }));
     let dyn_adapter: Rc<RefCell<dyn TNLP>> = adapter.clone();
     let return_status = app.optimize_tnlp(dyn_adapter);
@@ -493,6 +515,7 @@ pub fn solve(
         x,
         warm,
         elapsed: clock.now().saturating_sub(began),
+        first_iteration: a.first_iteration,
     };
     Ok((a.tr, outcome))
 }
