@@ -5,6 +5,7 @@ pub mod judge;
 pub mod outcome;
 pub mod process;
 pub mod random_scenario;
+pub mod rogue;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

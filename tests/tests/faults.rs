@@ -19,42 +19,10 @@ use wingman_tests::outcome::{assert_every_tr_followed, assert_mission_succeeded,
 use wingman_tests::process::{
     TempDir, harness, harness_logging, planner, planner_config, report, text, vehicle,
 };
+use wingman_tests::rogue::{Rogue, send_invalid};
 
 const FLIGHT: Duration = Duration::from_secs(900);
 const WAIT: Duration = Duration::from_secs(120);
-
-/// A publisher of every input service that sends whatever bytes it is given (a rogue
-/// process on the vehicle's services).
-struct Rogue {
-    tasking: iceoryx2::port::publisher::Publisher<Ipc, Tasking, ()>,
-    route: iceoryx2::port::publisher::Publisher<Ipc, LeadRoute, ()>,
-    lead_state: iceoryx2::port::publisher::Publisher<Ipc, LeadState, ()>,
-    threats: iceoryx2::port::publisher::Publisher<Ipc, ThreatReport, ()>,
-    tracks: iceoryx2::port::publisher::Publisher<Ipc, TrackFix, ()>,
-    ownship: iceoryx2::port::publisher::Publisher<Ipc, OwnshipState, ()>,
-    _node: iceoryx2::node::Node<Ipc>,
-}
-
-impl Rogue {
-    fn new(v: &str) -> Rogue {
-        let node = ipc::node(&format!("rogue-{v}"), false).unwrap();
-        Rogue {
-            tasking: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            route: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            lead_state: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            threats: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            tracks: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            ownship: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            _node: node,
-        }
-    }
-}
-
-/// Sends `m` on `p` after checking it is invalid (so the expected count is exact).
-fn send_invalid<M: Message + 'static>(p: &iceoryx2::port::publisher::Publisher<Ipc, M, ()>, m: M) {
-    assert!(m.validate().is_err(), "meant to be invalid: {m:?}");
-    p.send_copy(m).unwrap();
-}
 
 /// Sends `msgs` (each checked invalid) in batches no larger than the planner's subscriber
 /// buffer, waiting after each until the planner has taken it, so that none is dropped by
