@@ -420,3 +420,21 @@ fn the_duty_cycle_cap_holds_a_budget_per_thread() {
     let e = ServiceConfig::from_toml("[budget]\nplan_3d_ms = 0\n", "x").unwrap_err();
     assert!(e.to_string().contains("budget.plan_3d_ms"), "{e}");
 }
+
+/// B2: the splice starts from the ownship when any pending trigger is a deviation or a
+/// restart, whatever trigger names the plan.
+#[test]
+fn a_pending_deviation_splices_from_the_ownship_whatever_names_the_plan() {
+    let mut set = TriggerSet::EMPTY;
+    set.insert(Trigger::PopUp);
+    assert!(!splice_from_ownship(set, false));
+    assert!(splice_from_ownship(set, true), "a safe hold");
+    set.insert(Trigger::Deviation);
+    assert_eq!(set.primary(), Some(Trigger::PopUp));
+    assert!(splice_from_ownship(set, false));
+    assert!(!set.only_of(&[Trigger::PopUp, Trigger::ScheduledReplan]));
+    let mut restart = TriggerSet::EMPTY;
+    restart.insert(Trigger::Restart);
+    restart.insert(Trigger::Tasking);
+    assert!(splice_from_ownship(restart, false));
+}
