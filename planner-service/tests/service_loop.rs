@@ -296,3 +296,43 @@ fn a_restart_does_not_dead_reckon_a_stale_ownship_state() {
         &x0[..2]
     );
 }
+
+/// B9: a deviation that waited behind the compute gate while mission time moved on (the
+/// ownship state is now 10 s old) does not dead-reckon that stale state: the re-plan
+/// splices onto the current plan.
+#[test]
+fn a_deferred_deviation_does_not_dead_reckon_a_stale_ownship_state() {
+    let mut cfg = test_config(&vehicle("stale-deviation"));
+    cfg.budget.min_spacing_ms = 3000;
+    let mut d = Driven::new(cfg);
+    d.first_plan("2d-min-time-avoidable");
+    let plan = d.h.plans[0].clone();
+    let on = state_at(&plan, 10.0).unwrap();
+    let mut own = ownship_2d(10.0, 1, [on[0] + 3000.0, on[1], on[2]]);
+    own.cross_track_m = -3000.0;
+    d.h.set_time(10.0);
+    d.h.send_ownship(own);
+    d.pass();
+    assert_eq!(d.status().triggers_deferred, 1, "precondition: deferred");
+    // Mission time moves on without ownship states (a lead state carries it).
+    d.h.set_time(20.0);
+    let mut lead = LeadState::zeroed();
+    lead.time_s = 20.0;
+    lead.speed_mps = 150.0;
+    d.h.send_lead_state(lead);
+    d.pass();
+    d.settle();
+    assert_eq!(d.status().plans_made, 2);
+    let p = d.h.plans.last().unwrap();
+    assert_eq!(p.trigger(), Some(Trigger::Deviation));
+    let t_c = 20.0 + 20.0;
+    assert!((p.start_time_s - t_c).abs() < 1e-6, "{}", p.start_time_s);
+    let expected = state_at(&plan, t_c).unwrap();
+    let x0 = p.samples()[0].state;
+    assert!(
+        (x0[0] - expected[0]).hypot(x0[1] - expected[1]) < 1.0,
+        "spliced onto the plan {:?}, not the stale ownship state: {:?}",
+        &expected[..2],
+        &x0[..2]
+    );
+}
