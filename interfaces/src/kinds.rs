@@ -101,7 +101,8 @@ wire_enum! {
     pub enum PlannerState {
         /// Waiting for a trigger.
         Idle = 0,
-        /// A plan is being computed.
+        /// A plan is being computed, or a triggered plan waits for the compute gate (a
+        /// lock-step harness waits for both alike).
         Planning = 1,
         /// Running, but without a valid plan or with stale inputs.
         Degraded = 2,
