@@ -336,3 +336,62 @@ fn a_deferred_deviation_does_not_dead_reckon_a_stale_ownship_state() {
         &x0[..2]
     );
 }
+
+/// Restart race: a planner restarted mid-mission gets the tasking (and the threats) from
+/// history before the tracker's next ownship state. It waits for that state
+/// (`triggers.first_plan_wait_ms`) and plans a `Restart` from where the aircraft is, not
+/// an `Initial` plan from the tasking's start at t = 0. Without the wait the first pass
+/// after the tasking starts an `Initial` plan.
+#[test]
+fn a_restarted_planner_waits_for_the_ownship_before_its_first_plan() {
+    let mut cfg = test_config(&vehicle("restart-wait"));
+    cfg.triggers.first_plan_wait_ms = 60_000;
+    let mut d = Driven::new(cfg);
+    let sc = wingman_planner::scenario::bundled("2d-min-time-avoidable")
+        .unwrap()
+        .unwrap();
+    d.h.set_time(0.0);
+    for t in scenario_threats(&sc) {
+        d.h.send_threat(t);
+    }
+    d.h.send_tasking(tasking_from(&sc, 1));
+    for _ in 0..5 {
+        d.pass();
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    let s = d.status();
+    assert_eq!(s.plans_made, 0, "no plan before an ownship state");
+    assert_eq!(
+        s.state(),
+        Some(PlannerState::Planning),
+        "a lock-step harness waits"
+    );
+    let north = std::f64::consts::FRAC_PI_2;
+    let here = [20000.0, 30000.0, north];
+    d.h.set_time(120.0);
+    d.h.send_ownship(ownship_2d(120.0, 3, here));
+    d.settle();
+    assert_eq!(d.status().plans_made, 1);
+    let p = &d.h.plans[0];
+    assert_eq!(p.trigger(), Some(Trigger::Restart));
+    assert_eq!(p.plan_id, 4, "plan ids continue above the ownship's");
+    let x0 = p.samples()[0].state;
+    assert!(
+        (x0[0] - here[0]).abs() < 1.0 && (x0[1] - here[1]).abs() < 50_000.0,
+        "from the ownship's state (dead-reckoned to the commit time): {:?}",
+        &x0[..2]
+    );
+}
+
+/// The other side of the wait: a take-off tasking with no ownship state plans `Initial`
+/// from the tasking's start once the wait is over.
+#[test]
+fn a_first_plan_without_an_ownship_state_starts_after_the_wait() {
+    let mut cfg = test_config(&vehicle("first-wait"));
+    cfg.triggers.first_plan_wait_ms = 200;
+    let mut d = Driven::new(cfg);
+    d.first_plan("2d-min-time-avoidable");
+    let p = &d.h.plans[0];
+    assert_eq!(p.trigger(), Some(Trigger::Initial));
+    assert_eq!(p.start_time_s, 0.0);
+}

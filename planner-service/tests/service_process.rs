@@ -91,8 +91,11 @@ impl Drop for Planner {
 /// A configuration file for the child: fast heartbeat, generous budgets (debug builds).
 fn config_file(tag: &str) -> PathBuf {
     let path = std::env::temp_dir().join(format!("wingman-{}-{tag}.toml", std::process::id()));
+    // No wait for an ownship state before a first plan: `Planning` then means a plan in
+    // flight (the restart test sends its ownship state with the history anyway).
     let text = "[budget]\nplan_2d_ms = 20000\nplan_3d_ms = 20000\nduty_cycle = 1.0\n\
-                duty_window_ms = 60000\n\n[status]\nheartbeat_ms = 100\n";
+                duty_window_ms = 60000\n\n[status]\nheartbeat_ms = 100\n\n\
+                [triggers]\nfirst_plan_wait_ms = 0\n";
     std::fs::write(&path, text).unwrap();
     path
 }

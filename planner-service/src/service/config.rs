@@ -68,6 +68,12 @@ pub struct TriggerConfig {
     /// A scheduled re-plan time `t_r` is looked for only this long after a plan's start,
     /// s: a plan just made from the newest estimate is not re-made at once.
     pub replan_min_lead_s: f64,
+    /// Before its first plan the service waits this long (wall clock) after the tasking
+    /// for an ownship state, ms: a planner restarted mid-mission gets the tasking from
+    /// history before the tracker's next state, and must plan from where the aircraft
+    /// is (`Restart`), not from the tasking's start (`Initial`). With an ownship state at
+    /// hand it plans at once.
+    pub first_plan_wait_ms: u64,
 }
 
 /// Inputs that stop arriving are reported in `PlannerStatus::stale_inputs` (wall clock).
@@ -136,6 +142,7 @@ impl Default for TriggerConfig {
             deviation_cross_m: 500.0,
             deviation_vertical_m: 200.0,
             replan_min_lead_s: 1.0,
+            first_plan_wait_ms: 300,
         }
     }
 }
@@ -260,6 +267,12 @@ impl ServiceConfig {
         }
         if !(t.replan_min_lead_s.is_finite() && t.replan_min_lead_s >= 0.0) {
             return bad("triggers.replan_min_lead_s", "must not be negative".into());
+        }
+        if t.first_plan_wait_ms > 60_000 {
+            return bad(
+                "triggers.first_plan_wait_ms",
+                "must be at most 60000 (a first plan would wait a minute)".into(),
+            );
         }
         if self.status.heartbeat_ms == 0 {
             return bad("status.heartbeat_ms", "must be positive".into());

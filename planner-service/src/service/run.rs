@@ -294,6 +294,9 @@ pub struct MessageLoop {
     batch_count: u64,
     /// A first tasking (or one after a failed first plan) waits for its plan.
     awaiting_first: bool,
+    /// Until when (wall clock) a first plan waits for an ownship state, to tell a restart
+    /// mid-mission from a take-off (`triggers.first_plan_wait_ms`).
+    first_wait_until: Option<Duration>,
     /// Triggers whose plan had no state to start from (no fresh ownship state where the
     /// plan cannot say): raised again by the next ownship state of the tasking's model.
     awaiting_start: Option<TriggerSet>,
@@ -385,6 +388,7 @@ impl MessageLoop {
             awaiting_first: false,
             retry_first_at: None,
             awaiting_start: None,
+            first_wait_until: None,
             gate,
             counters: Counters::default(),
             next_plan_id: 1,
@@ -415,15 +419,29 @@ impl MessageLoop {
         &self.node
     }
 
-    /// How long the WaitSet may sleep before a deferred plan is due (`Duration::MAX`:
-    /// until an event or the heartbeat).
+    /// How long the WaitSet may sleep before a deferred plan is due, or a first plan's
+    /// wait for an ownship state ends (`Duration::MAX`: until an event or the heartbeat).
     pub fn next_timeout(&self) -> Duration {
-        match (self.in_flight, self.pending.wake_at) {
-            (None, Some(at)) if !self.pending.set.is_empty() => at
+        let deferred = match (self.in_flight, self.pending.wake_at) {
+            (None, Some(at)) if !self.pending.set.is_empty() => Some(at),
+            _ => None,
+        };
+        let first = self.first_wait_until.filter(|_| self.waiting_for_ownship());
+        match deferred.into_iter().chain(first).min() {
+            Some(at) => at
                 .saturating_sub(self.clock.now())
                 .max(Duration::from_micros(100)),
-            _ => Duration::MAX,
+            None => Duration::MAX,
         }
+    }
+
+    /// A first plan waits for an ownship state (see `first_wait_until`).
+    fn waiting_for_ownship(&self) -> bool {
+        self.awaiting_first
+            && self.world.ownship.is_none()
+            && self
+                .first_wait_until
+                .is_some_and(|at| self.clock.now() < at)
     }
 
     /// The last status published.
@@ -572,7 +590,13 @@ impl MessageLoop {
             self.content_revision = t.revision;
         }
         match decision {
-            TaskingDecision::First => self.awaiting_first = true,
+            TaskingDecision::First => {
+                self.awaiting_first = true;
+                if self.world.ownship.is_none() {
+                    let wait = Duration::from_millis(self.cfg.triggers.first_plan_wait_ms);
+                    self.first_wait_until = Some(self.clock.now() + wait);
+                }
+            }
             TaskingDecision::Changed if !self.has_plan && self.in_flight.is_none() => {
                 info!(revision = t.revision, "tasking changed before a first plan");
                 self.awaiting_first = true;
@@ -803,6 +827,7 @@ impl MessageLoop {
         let retry_due = self.retry_first_at.is_none_or(|at| self.clock.now() >= at);
         if self.awaiting_first
             && retry_due
+            && !self.waiting_for_ownship()
             && let Some(t) = &self.world.tasking
         {
             let needs_route = t.objective() == Some(Objective::MinTimeRendezvous);
@@ -1225,9 +1250,13 @@ impl MessageLoop {
     pub fn status_message(&self) -> PlannerStatus {
         let wall = self.clock.now();
         let stale = self.world.stale_bits(wall, &self.cfg.staleness);
-        // `Planning` also while a triggered plan waits for the compute gate: a lock-step
-        // harness then waits for it as for a plan in flight.
-        let state = if self.in_flight.is_some() || !self.pending.set.is_empty() {
+        // `Planning` also while a triggered plan waits for the compute gate, or a first
+        // plan for an ownship state: a lock-step harness then waits for it as for a plan
+        // in flight.
+        let state = if self.in_flight.is_some()
+            || !self.pending.set.is_empty()
+            || self.waiting_for_ownship()
+        {
             PlannerState::Planning
         } else if stale != 0
             || (self.world.tasking.is_some() && !self.has_plan)
