@@ -86,13 +86,18 @@ impl Default for PlannerSettings {
                 feral_static_pivoting: true,
                 ..NlpSettings::default()
             },
-            // Measured on the 15 canonical scenarios, seeds 1-2: the same winners and plan
-            // costs as at the working tolerance, 15 % less CPU (docs/BENCHMARKS.md).
+            // Measured on the 15 canonical scenarios, seeds 1-4: the same winners and plan
+            // costs as at the working tolerance, 15 % less CPU (docs/BENCHMARKS.md). An
+            // acceptable stop must still be feasible enough to rank (below
+            // `ranking_feasibility_tol`): with the solver's default (1e-2) the swarm's own
+            // start of 2d-fixed-time-unavoidable, seed 3, stopped at 3e-4 and was dropped,
+            // and the plan landed in a basin 18 % higher.
             ranking_nlp: NlpSettings {
                 feral_static_pivoting: true,
                 tol: 1e-4,
                 acceptable_tol: 1e-3,
                 acceptable_iter: 2,
+                acceptable_constr_viol_tol: Some(1e-5),
                 ..NlpSettings::default()
             },
             refine: RefineSettings::default(),

@@ -31,6 +31,9 @@ pub struct NlpSettings {
     /// "Acceptable" tolerance and the number of acceptable iterations that stop the solve.
     pub acceptable_tol: f64,
     pub acceptable_iter: i32,
+    /// Largest constraint violation an "acceptable" stop may leave (`None`: the solver's
+    /// default, 1e-2).
+    pub acceptable_constr_viol_tol: Option<f64>,
     /// Iteration limit.
     pub max_iter: i32,
     /// Largest scaled constraint violation of an iterate that counts as feasible.
@@ -71,6 +74,7 @@ impl Default for NlpSettings {
             tol: 1e-7,
             acceptable_tol: 1e-5,
             acceptable_iter: 5,
+            acceptable_constr_viol_tol: None,
             max_iter: 300,
             feasibility_tol: 1e-6,
             mu_strategy: "monotone",
@@ -346,6 +350,9 @@ fn application(
     };
     num(o, "tol", settings.tol)?;
     num(o, "acceptable_tol", settings.acceptable_tol)?;
+    if let Some(v) = settings.acceptable_constr_viol_tol {
+        num(o, "acceptable_constr_viol_tol", v)?;
+    }
     num(o, "max_wall_time", budget.as_secs_f64().max(1e-3))?;
     let int = |o: &mut OptionsList, name: &'static str, v: i32| {
         o.set_integer_value(name, v, true, false)
