@@ -840,15 +840,17 @@ fn hog(limit: Duration) {
     }
 }
 
+/// Other cargo and rustc processes (the `cargo bench` that started this one aside).
 fn other_builds() -> String {
+    let parent = std::os::unix::process::parent_id().to_string();
     ["cargo", "rustc"]
         .iter()
         .filter_map(|name| {
-            let out = Command::new("pgrep")
-                .args(["-c", "-x", name])
-                .output()
-                .ok()?;
-            let n: u32 = String::from_utf8_lossy(&out.stdout).trim().parse().ok()?;
+            let out = Command::new("pgrep").args(["-x", name]).output().ok()?;
+            let n = String::from_utf8_lossy(&out.stdout)
+                .lines()
+                .filter(|pid| pid.trim() != parent)
+                .count();
             (n > 0).then(|| format!("{n} {name}"))
         })
         .collect::<Vec<_>>()
