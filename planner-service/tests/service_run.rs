@@ -13,7 +13,6 @@ use std::time::Duration;
 
 use service_support::*;
 use wingman_interfaces::*;
-use wingman_planner::scenario::bundled;
 use wingman_planner::service::ExitReason;
 use wingman_planner::service::export::state_at;
 
@@ -25,25 +24,7 @@ fn first_plan(tag: &str) -> (ServiceThread, FakeHarness) {
     let v = vehicle(tag);
     let service = ServiceThread::start(test_config(&v));
     let mut h = FakeHarness::new(&v);
-    assert!(
-        h.wait_until(Duration::from_secs(20), |h| h.status.is_some()),
-        "no heartbeat from the service"
-    );
-    let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();
-    h.set_time(0.0);
-    for t in scenario_threats(&sc) {
-        h.send_threat(t);
-    }
-    h.send_tasking(tasking_from(&sc, 1));
-    h.wake();
-    assert!(
-        h.wait_until(PLAN_WAIT, |h| !h.plans.is_empty()
-            && h.status.is_some_and(
-                |s| s.plans_made == 1 && s.state() != Some(PlannerState::Planning)
-            )),
-        "no first plan; status {:?}",
-        h.status
-    );
+    h.first_plan_of("2d-min-time-avoidable", PLAN_WAIT);
     (service, h)
 }
 

@@ -98,25 +98,7 @@ fn planner_with_first_plan(
     let cfg = planner_config(dir.path(), 2000, 6000, extra);
     let p = planner(&cfg, &v, &dir.path().join("planner.log"));
     let mut h = FakeHarness::new(&v);
-    assert!(
-        h.wait_until(Duration::from_secs(60), |h| h.status.is_some()),
-        "no heartbeat from the planner"
-    );
-    let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();
-    h.set_time(0.0);
-    for t in scenario_threats(&sc) {
-        h.send_threat(t);
-    }
-    h.send_tasking(tasking_from(&sc, 1));
-    h.wake();
-    assert!(
-        h.wait_until(WAIT, |h| !h.plans.is_empty()
-            && h.status.is_some_and(
-                |s| s.plans_made == 1 && s.state() != Some(PlannerState::Planning)
-            )),
-        "no first plan: {:?}",
-        h.status
-    );
+    h.first_plan_of("2d-min-time-avoidable", WAIT);
     (p, h, v)
 }
 

@@ -101,21 +101,7 @@ fn arbitrary_messages_to_a_running_service_are_rejected_without_effect() {
     let v = vehicle("fuzz");
     let service = ServiceThread::start(test_config(&v));
     let mut h = FakeHarness::new(&v);
-    assert!(h.wait_until(Duration::from_secs(30), |h| h.status.is_some()));
-    let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();
-    h.set_time(0.0);
-    for t in scenario_threats(&sc) {
-        h.send_threat(t);
-    }
-    h.send_tasking(tasking_from(&sc, 1));
-    h.wake();
-    assert!(
-        h.wait_until(WAIT, |h| !h.plans.is_empty()
-            && h.status.is_some_and(
-                |s| s.plans_made == 1 && s.state() != Some(PlannerState::Planning)
-            )),
-        "no first plan"
-    );
+    h.first_plan_of("2d-min-time-avoidable", WAIT);
     let before = h.last_status();
     let rogue = Rogue::new(&v);
     let sent = RefCell::new(0u64);

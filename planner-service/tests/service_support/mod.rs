@@ -214,6 +214,32 @@ impl FakeHarness {
         self.wake.notify().unwrap();
     }
 
+    /// Waits for the planner's first heartbeat, sends the threats and the tasking of the
+    /// bundled scenario `name` at mission time 0, wakes the planner and waits (at most
+    /// `wait`) until its first plan is published and it is no longer planning.
+    pub fn first_plan_of(&mut self, name: &str, wait: Duration) -> Scenario {
+        assert!(
+            self.wait_until(Duration::from_secs(60), |h| h.status.is_some()),
+            "no heartbeat from the planner"
+        );
+        let sc = wingman_planner::scenario::bundled(name).unwrap().unwrap();
+        self.set_time(0.0);
+        for t in scenario_threats(&sc) {
+            self.send_threat(t);
+        }
+        self.send_tasking(tasking_from(&sc, 1));
+        self.wake();
+        assert!(
+            self.wait_until(wait, |h| !h.plans.is_empty()
+                && h.status.is_some_and(
+                    |s| s.plans_made == 1 && s.state() != Some(PlannerState::Planning)
+                )),
+            "no first plan of {name}: {:?}",
+            self.status
+        );
+        sc
+    }
+
     /// Takes the plans and statuses published so far.
     pub fn poll(&mut self) {
         let _ = self.plan.update_connections();
