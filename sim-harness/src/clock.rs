@@ -129,6 +129,16 @@ impl Periodic {
         }
     }
 
+    /// The schedule `first + k period` taken up at `from` (a resumed flight): its next tick
+    /// is the first one at or after `from` (within 1 µs).
+    pub fn resumed(first: f64, period: f64, from: f64) -> Periodic {
+        let k = ((from - first - 1e-6) / period).ceil().max(0.0);
+        Periodic {
+            period,
+            next: first + k * period,
+        }
+    }
+
     /// Whether a tick falls at or before `t` (within 1 µs); takes at most one tick per call,
     /// so a step longer than the period yields one tick per step and keeps the rest for
     /// later steps.

@@ -78,6 +78,16 @@ pub enum Entry {
     Sync { mission_s: f64, sequence: u64 },
     /// Last record.
     End { mission_s: f64, completed: bool },
+    /// A resumed flight (`fly --resume`), right after `Start`: the flight took over the
+    /// mission of a planner already flying it, at mission time `mission_s` (the planner was
+    /// at `planner_s`, flying plan `plan_id`, with inputs processed up to `last_sequence`).
+    /// Added after `End`, so logs written before it read as they did.
+    Resume {
+        mission_s: f64,
+        planner_s: f64,
+        plan_id: u64,
+        last_sequence: u64,
+    },
 }
 
 /// The log could not be written or read.

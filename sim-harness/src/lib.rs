@@ -14,7 +14,9 @@
 //! - [`flight_log`]: `flight.log`, every message both ways;
 //! - [`report`], [`plots`]: `report.json` and the PNG plots;
 //! - [`replay`]: a flown log's planner inputs fed to the planner in-process, every plan
-//!   compared byte for byte.
+//!   compared byte for byte;
+//! - [`resume`]: `fly --resume`, a new harness taking over the mission a planner flies
+//!   after its harness died.
 
 pub mod clock;
 pub mod datalink;
@@ -26,6 +28,7 @@ pub mod plots;
 pub mod process;
 pub mod replay;
 pub mod report;
+pub mod resume;
 pub mod sensor;
 pub mod tracker;
 
@@ -66,9 +69,13 @@ pub fn summary(r: &report::Report, out: &std::path::Path, pngs: &[String]) -> St
         .map(|t| format!("{:.0} m", t.miss_m))
         .collect();
     let mut s = format!(
-        "{}: {} at t = {:.1} s ({}), targets missed by [{}], final error {:.1} m, min F static {}, \
+        "{}{}: {} at t = {:.1} s ({}), targets missed by [{}], final error {:.1} m, min F static {}, \
          exposure {:.2} s, {} plan(s), {} re-plan(s), {} hold(s), {:.1} s wall\n",
         r.scenario,
+        r.resumed_at_s.map_or(String::new(), |t| format!(
+            " (resumed at {t:.1} s, {} target(s) passed before)",
+            r.targets_before_resume.len()
+        )),
         if r.completed {
             "COMPLETED"
         } else {

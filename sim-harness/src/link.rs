@@ -118,6 +118,13 @@ impl PlannerLink {
         self.sequence
     }
 
+    /// Continues the header sequence above `last` (a resumed flight: the planner has
+    /// processed inputs up to `last`, and the lock-step clock waits for the status to echo
+    /// a higher one).
+    pub fn continue_sequence(&mut self, last: u64) {
+        self.sequence = self.sequence.max(last);
+    }
+
     /// The newest status taken.
     pub fn status(&self) -> Option<&PlannerStatus> {
         self.last_status.as_ref()

@@ -29,6 +29,11 @@ enum Command {
         /// Output folder (default runs/<scenario>/).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Take over the mission a planner is already flying (after its harness died):
+        /// start at the planner's mission time on its current plan, with the scenario's
+        /// world as it stands then (needs --planner external).
+        #[arg(long)]
+        resume: bool,
     },
     /// Feeds a flight log's planner inputs to the planner in-process and checks that
     /// every plan comes out byte-identical (exit 1 if not).
@@ -158,7 +163,19 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Fly { scenario, fly, out } => {
+        Command::Fly {
+            scenario,
+            fly,
+            out,
+            resume,
+        } => {
+            if resume && fly.planner != "external" {
+                eprintln!(
+                    "error: {}",
+                    wingman_harness::resume::ResumeError::NotExternal
+                );
+                return ExitCode::from(2);
+            }
             let sc = match load_by_path_or_name(&scenario) {
                 Ok(sc) => sc,
                 Err(e) => {
@@ -174,6 +191,7 @@ fn main() -> ExitCode {
                 eprintln!("error: {e}");
                 return ExitCode::from(2);
             }
+            opts.resume = resume;
             fly_one(&opts)
         }
     }

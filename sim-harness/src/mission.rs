@@ -7,7 +7,8 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use wingman_interfaces::{
-    Model, PlannerStatus, Quality, ThreatKind, ThreatReport, Trigger, Wire, threat_name,
+    Model, Plan, PlannerState, PlannerStatus, Quality, Service, ThreatKind, ThreatReport, Trigger,
+    Wire, service_name, threat_name,
 };
 use wingman_planner::estimation::{Estimate, GaussMarkov, KalmanFilter, Road};
 use wingman_planner::problem::{Problem, ProblemError};
@@ -21,6 +22,7 @@ use crate::datalink::{Datalink, DatalinkError};
 use crate::flight_log::{Entry, LogError, LogWriter};
 use crate::link::{LinkError, PlannerLink, Received};
 use crate::process::{PlannerProcess, ProcessError, planner_binary};
+use crate::resume::{self, ResumeError, Resumed, Timeline};
 use crate::sensor::{SensorError, SensorOutput, ThreatSensor};
 use crate::tracker::{Hold, InnerLoop, ReceivedPlan, TrackerSample};
 
@@ -55,6 +57,11 @@ pub struct FlyOptions {
     pub progress: bool,
     /// Faults injected into the flight (fault-tolerance tests); none by default.
     pub faults: Faults,
+    /// Resume the mission the (external) planner is flying instead of starting it
+    /// (`fly --resume`, see [`crate::resume`]).
+    pub resume: bool,
+    /// Longest wait for the planner's status and plan when resuming.
+    pub resume_wait: Duration,
 }
 
 /// Faults the harness can inject into a flight, for the fault-tolerance tests of
@@ -132,6 +139,8 @@ impl FlyOptions {
             planner_timeout: Duration::from_secs(300),
             progress: true,
             faults: Faults::default(),
+            resume: false,
+            resume_wait: resume::RESUME_WAIT,
         }
     }
 }
@@ -187,6 +196,8 @@ pub enum FlyError {
     },
     #[error("{0}")]
     Planner(String),
+    #[error(transparent)]
+    Resume(#[from] ResumeError),
 }
 
 /// How a flight ended.
@@ -233,6 +244,9 @@ pub struct Flight {
     pub rejected: u64,
     /// Wall-clock duration of the flight.
     pub wall: Duration,
+    /// Where a resumed flight (`fly --resume`) took the mission over (`None`: flown from
+    /// the start). The samples, the truth and every plan then begin at the resume.
+    pub resumed: Option<Resumed>,
 }
 
 /// The moving threats' filters as the planner runs them (same reports, same fixes, same
@@ -274,6 +288,20 @@ impl Mirror {
         }
     }
 
+    /// Records every moving threat's estimate as `plan` was made from it.
+    fn snapshot(&self, plan: &Plan, out: &mut Vec<EstimateSnapshot>) {
+        for threat in 0..self.filters.len() {
+            if let Some(estimate) = self.estimate(threat) {
+                out.push(EstimateSnapshot {
+                    plan_id: plan.plan_id,
+                    threat,
+                    at_s: plan.created_at_s,
+                    estimate,
+                });
+            }
+        }
+    }
+
     fn estimate(&self, k: usize) -> Option<Estimate> {
         self.filters
             .get(k)
@@ -284,6 +312,9 @@ impl Mirror {
 
 /// Flies `opts.scenario` end to end.
 pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
+    if opts.resume && opts.planner != PlannerMode::External {
+        return Err(ResumeError::NotExternal.into());
+    }
     let sc = &opts.scenario;
     let problem = Problem::from_scenario(sc)?;
     let mut datalink = Datalink::new(sc)?;
@@ -333,15 +364,27 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
 
     // The planner is up (and subscribed) once its heartbeat arrives.
     let up = Instant::now();
+    let status_wait = if opts.resume {
+        opts.resume_wait
+    } else {
+        Duration::from_secs(30)
+    };
+    // Plans that come with it (the `plan` service's history: a resumed flight's plan).
+    let mut early = Received::default();
     while link.status().is_none() {
-        link.poll()?;
+        let r = link.poll()?;
+        early.plans.extend(r.plans);
+        early.rejected += r.rejected;
         if planner.as_mut().is_some_and(|p| !p.is_running()) {
             return Err(FlyError::Planner(format!(
                 "the planner exited at start-up (see {})",
                 opts.out_dir.join("planner.log").display()
             )));
         }
-        if up.elapsed() > Duration::from_secs(30) {
+        if up.elapsed() > status_wait {
+            if opts.resume {
+                return Err(no_status(&vehicle, status_wait).into());
+            }
             return Err(FlyError::Planner(format!(
                 "no status from a planner on vehicle `{vehicle}` within 30 s"
             )));
@@ -351,20 +394,86 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
 
     let t0 = sc.start.time_s;
     let dt = opts.step_s;
-    let mut lead_tick = Periodic::new(t0, 1.0 / opts.lead_rate_hz);
     let mut mirror = Mirror {
         filters: vec![None; sc.moving_threats.len()],
     };
     let moving_base = sensor.static_count() as u32 + 1;
+    let mut rejected = early.rejected;
+    // A resumed flight: the planner's plan and the world at the resume point.
+    let mut take_over: Option<(Resumed, Box<Plan>, Timeline)> = None;
+    if opts.resume {
+        let (plan, r) = wait_for_plan(&mut link, early.plans, &vehicle, opts.resume_wait, up)?;
+        rejected += r;
+        let status = link
+            .status()
+            .copied()
+            .ok_or_else(|| no_status(&vehicle, opts.resume_wait))?;
+        let point = resume::resume_point(&status, &plan, t0, dt)?;
+        let matched = resume::check_plan(sc, &datalink, &plan, point.planner_s, point.t_s)?;
+        let timeline = resume::replay_timeline(&mut datalink, &mut sensor, t0, dt, point.step);
+        for out in &timeline.sensor {
+            match out {
+                SensorOutput::Report(r) if r.threat_id >= moving_base => {
+                    mirror.report((r.threat_id - moving_base) as usize, r);
+                }
+                SensorOutput::Report(_) => {}
+                SensorOutput::Fix(f) => {
+                    mirror.fix((f.threat_id.saturating_sub(moving_base)) as usize, f);
+                }
+            }
+        }
+        link.continue_sequence(point.last_sequence);
+        link.set_time(point.t_s);
+        link.log.write(&Entry::Resume {
+            mission_s: point.t_s,
+            planner_s: point.planner_s,
+            plan_id: plan.plan_id,
+            last_sequence: point.last_sequence,
+        });
+        tracing::info!(
+            mission_s = point.t_s,
+            planner_s = point.planner_s,
+            plan_id = plan.plan_id,
+            last_sequence = point.last_sequence,
+            targets_passed = matched.passed,
+            "resuming the planner's mission"
+        );
+        let resumed = Resumed {
+            point,
+            plan_id: plan.plan_id,
+            matched,
+        };
+        take_over = Some((resumed, plan, timeline));
+    }
+    let resumed = take_over.as_ref().map(|(r, _, _)| *r);
+    let t_start = resumed.map_or(t0, |r| r.point.t_s);
+    let k_start = resumed.map_or(0, |r| r.point.step);
+    let mut lead_tick = Periodic::resumed(t0, 1.0 / opts.lead_rate_hz, t_start);
     let mut truth: Vec<Vec<(f64, [f64; 3])>> = vec![Vec::new(); sc.moving_threats.len()];
     let mut estimates = Vec::new();
-    let mut samples = vec![tracker.sample()];
-    let mut rejected = 0;
-    let mut progress = Progress::new(opts.progress);
-    let mut pacer = Pacer::new(opts.clock, t0);
     let mut time_limit = opts.time_limit_s.unwrap_or(t0 + 7200.0);
-    let mut k: u64 = 0;
-    let mut t = t0;
+    // The world the resumed flight's first step publishes again.
+    let mut replayed: Option<Timeline> = None;
+    if let Some((r, plan, timeline)) = take_over {
+        mirror.snapshot(&plan, &mut estimates);
+        if opts.time_limit_s.is_none() {
+            time_limit = default_time_limit(t0, plan.final_time_s);
+        }
+        tracker.start_on(
+            r.point.t_s,
+            ReceivedPlan {
+                plan,
+                received_at_s: r.point.t_s,
+                available_at_s: r.point.t_s,
+            },
+        );
+        replayed = Some(timeline);
+    }
+    let mut samples = vec![tracker.sample()];
+    let mut progress = Progress::new(opts.progress);
+    let mut pacer = Pacer::new(opts.clock, t_start);
+    let mut k: u64 = k_start;
+    let mut t = t_start;
     let faults = &opts.faults;
     let mut killed = false;
     // Mission time at which a killed planner is started again.
@@ -431,6 +540,20 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
         // 1. This step's inputs.
         link.set_time(t);
         link.refresh();
+        if let Some(world) = replayed.take() {
+            // A resumed flight's first step: the world in force at the resume, again. The
+            // planner holds it already (repeats: no re-plan); the new publishers' history
+            // holds it for later subscribers.
+            for r in world.reports() {
+                link.send_threat(*r)?;
+            }
+            if let Some(r) = world.route {
+                link.send_route(r)?;
+            }
+            if let Some(tk) = world.tasking {
+                link.send_tasking(tk)?;
+            }
+        }
         if let Some(at) = faults.popup_burst_at_s
             && t >= at
             && burst_sent < faults.popup_burst_count
@@ -479,7 +602,7 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
         // 2. The planner's answer: lock-step waits for it.
         // Every clock waits for the first plan at take-off (it is planned before the
         // flight); the paced clocks start after it.
-        let received: Received = if (opts.clock.is_lock_step() || k == 0) && !planner_down {
+        let received: Received = if (opts.clock.is_lock_step() || k == k_start) && !planner_down {
             let (r, ok) = link.sync(opts.planner_timeout, || {
                 planner.as_mut().is_none_or(|p| p.is_running())
             })?;
@@ -494,8 +617,8 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
                     opts.out_dir.join("planner.log").display()
                 )));
             }
-            if k == 0 {
-                pacer = Pacer::new(opts.clock, t0);
+            if k == k_start {
+                pacer = Pacer::new(opts.clock, t_start);
             }
             r
         } else {
@@ -508,19 +631,9 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
                 (true, _) => (plan.created_at_s + plan.compute_ms / 1e3).max(t),
                 (false, _) => t,
             };
-            for (i, _) in sc.moving_threats.iter().enumerate() {
-                if let Some(e) = mirror.estimate(i) {
-                    estimates.push(EstimateSnapshot {
-                        plan_id: plan.plan_id,
-                        threat: i,
-                        at_s: plan.created_at_s,
-                        estimate: e,
-                    });
-                }
-            }
+            mirror.snapshot(&plan, &mut estimates);
             if tracker.plans().is_empty() && opts.time_limit_s.is_none() {
-                let duration = plan.final_time_s - t0;
-                time_limit = t0 + (3.0 * duration).max(duration + 600.0);
+                time_limit = default_time_limit(t0, plan.final_time_s);
             }
             tracing::debug!(
                 plan_id = plan.plan_id,
@@ -583,7 +696,75 @@ pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
         last_status,
         rejected,
         wall: wall_start.elapsed(),
+        resumed,
     })
+}
+
+/// The time limit of a flight whose first plan ends at `final_s`: three times the plan's
+/// duration, at least ten minutes more.
+fn default_time_limit(t0: f64, final_s: f64) -> f64 {
+    let duration = final_s - t0;
+    t0 + (3.0 * duration).max(duration + 600.0)
+}
+
+/// Waits (at most `wait` from `since`) for the planner's current plan — the `plan`
+/// service's history (`early`: plans taken with the first status), then whatever it
+/// publishes — with the planner not planning and the plan the one its status names.
+/// Returns the newest plan and the invalid messages dropped. A planner still planning at the limit is resumed on the plan it has (the
+/// plan it is computing arrives as any re-plan).
+fn wait_for_plan(
+    link: &mut PlannerLink,
+    early: Vec<Box<Plan>>,
+    vehicle: &str,
+    wait: Duration,
+    since: Instant,
+) -> Result<(Box<Plan>, u64), FlyError> {
+    let mut newest: Option<Box<Plan>> = None;
+    let mut rejected = 0;
+    let mut taken = early;
+    loop {
+        for p in taken.drain(..) {
+            if newest.as_ref().is_none_or(|n| p.plan_id > n.plan_id) {
+                newest = Some(p);
+            }
+        }
+        let status = link.status();
+        let idle = status.is_some_and(|s| s.state() != Some(PlannerState::Planning));
+        let current = match (&newest, status) {
+            (Some(p), Some(s)) => p.plan_id >= s.current_plan_id,
+            _ => false,
+        };
+        if idle && current {
+            break;
+        }
+        if since.elapsed() > wait {
+            if newest.is_some() {
+                tracing::warn!(
+                    planning = !idle,
+                    newer_announced = !current,
+                    "resuming on the newest plan received: the planner is still planning or \
+                     announces a newer plan"
+                );
+            }
+            break;
+        }
+        link.wait(Duration::from_millis(100))?;
+        let r = link.poll()?;
+        rejected += r.rejected;
+        taken = r.plans;
+    }
+    let plan = newest.ok_or_else(|| ResumeError::NoPlan {
+        service: service_name(vehicle, Service::Plan).unwrap_or_default(),
+        within_s: wait.as_secs_f64(),
+    })?;
+    Ok((plan, rejected))
+}
+
+fn no_status(vehicle: &str, wait: Duration) -> ResumeError {
+    ResumeError::NoStatus {
+        service: service_name(vehicle, Service::Status).unwrap_or_default(),
+        within_s: wait.as_secs_f64(),
+    }
 }
 
 /// The progress line: mission time, phase, plan flown, re-plans so far.

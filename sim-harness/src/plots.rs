@@ -241,10 +241,11 @@ pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
         });
     }
     let title = format!(
-        "{} — {} plan(s), flown with the {} clock",
+        "{} — {} plan(s), flown with the {} clock{}",
         sc.name,
         flight.plans.len(),
-        flight.clock
+        flight.clock,
+        resumed_note(flight)
     );
     let plot = MapPlot {
         title,
@@ -276,6 +277,13 @@ fn keep_out(
     ))
 }
 
+/// A resumed flight's note for the titles (empty otherwise).
+fn resumed_note(flight: &Flight) -> String {
+    flight.resumed.map_or(String::new(), |r| {
+        format!(" (resumed at {:.1} s)", r.point.t_s)
+    })
+}
+
 /// The timeline: exposure, deviation, re-plans.
 pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()> {
     let times: Vec<f64> = flight.samples.iter().map(|s| s.t).collect();
@@ -289,8 +297,9 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
     let root = root
         .titled(
             &format!(
-                "{} — exposure, deviation and re-plans along the flight",
-                flight.scenario.name
+                "{} — exposure, deviation and re-plans along the flight{}",
+                flight.scenario.name,
+                resumed_note(flight)
             ),
             ("sans-serif", 24),
         )
@@ -385,8 +394,11 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
     replan_lines(&mut c, flight, (-d_max, d_max))?;
     legend(&mut c)?;
 
-    // 3. Plans: which one is flown, and the compute time of each.
-    let n = flight.plans.len().max(1) as f64;
+    // 3. Plans: which one is flown, and the compute time of each. Plan ids need not start
+    // at 1 (a resumed flight, a restarted planner).
+    let ids = flight.plans.iter().map(|p| p.plan.plan_id);
+    let id_lo = ids.clone().min().unwrap_or(1) as f64;
+    let id_hi = ids.max().unwrap_or(1) as f64;
     let mut c = ChartBuilder::on(&panels[2])
         .margin(12)
         .x_label_area_size(36)
@@ -395,7 +407,7 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
             "plan flown (bars: trigger time to start; label: trigger, compute time, quality)",
             ("sans-serif", 18),
         )
-        .build_cartesian_2d(t0..t1, 0.0..(n + 1.0))
+        .build_cartesian_2d(t0..t1, (id_lo - 1.0)..(id_hi + 1.0))
         .map_err(boxed)?;
     c.configure_mesh()
         .x_desc("mission time [s]")
@@ -521,7 +533,11 @@ pub fn side(flight: &Flight, path: &Path) -> PlotResult<()> {
         .x_label_area_size(40)
         .y_label_area_size(70)
         .caption(
-            format!("{} — side view: altitude against mission time", sc.name),
+            format!(
+                "{} — side view: altitude against mission time{}",
+                sc.name,
+                resumed_note(flight)
+            ),
             ("sans-serif", 22),
         )
         .build_cartesian_2d(t0..t1, km(lo - margin - 200.0)..km(hi + margin))

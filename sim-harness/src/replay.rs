@@ -6,6 +6,9 @@
 //! plan that comes out is compared with the logged one **byte for byte**, except
 //! `compute_ms` (a wall-clock measurement): same inputs and seed, same plan.
 //!
+//! A resumed flight's log (`fly --resume`) is refused: the planner's world before the
+//! resume came from another harness and is not in it.
+//!
 //! A log flown with the lock-step clock replays exactly. A real-time log has no barriers:
 //! the replay then syncs after each mission time's inputs, which need not be how the
 //! planner saw them in flight, and says so.
@@ -34,6 +37,11 @@ pub enum ReplayError {
     Link(#[from] crate::link::LinkError),
     #[error("the planner service: {0}")]
     Service(String),
+    #[error(
+        "a resumed flight's log (taken over at mission time {mission_s:.1} s from a planner on plan {plan_id}): \
+         the planner's world before the resume is not in it, so its plans cannot be replayed"
+    )]
+    Resumed { mission_s: f64, plan_id: u64 },
 }
 
 /// One plan that came out different.
@@ -196,6 +204,14 @@ pub fn replay(log: &Path, timeout: Duration) -> Result<ReplayOutcome, ReplayErro
             }));
         }
     };
+    if let Some((mission_s, plan_id)) = entries.iter().find_map(|e| match e {
+        Entry::Resume {
+            mission_s, plan_id, ..
+        } => Some((*mission_s, *plan_id)),
+        _ => None,
+    }) {
+        return Err(ReplayError::Resumed { mission_s, plan_id });
+    }
     let mut config = ServiceConfig::from_toml(&config_text, "flight.log (planner_config)")?;
     config.vehicle_id = unique_vehicle_id("replay");
     let lock_step = entries.iter().any(|e| matches!(e, Entry::Sync { .. }));

@@ -24,6 +24,14 @@ pub struct TargetOutcome {
     pub revision: u32,
 }
 
+/// A target a resumed flight did not fly to: the planner had passed it before the resume.
+#[derive(Debug, Clone, Serialize)]
+pub struct TargetBeforeResume {
+    pub position_m: [f64; 3],
+    /// Tasking revision that set this target.
+    pub revision: u32,
+}
+
 /// Smallest `F` of one threat along the flown path.
 #[derive(Debug, Clone, Serialize)]
 pub struct ThreatOutcome {
@@ -81,6 +89,12 @@ pub struct Report {
     pub objective: String,
     pub clock: String,
     pub vehicle_id: String,
+    /// Mission time at which a resumed flight (`fly --resume`) took the mission over
+    /// (`None`: flown from the start). The path metrics cover the path flown from then on.
+    pub resumed_at_s: Option<f64>,
+    /// The targets the planner had passed before the resume (empty unless resumed): not
+    /// flown by this harness, so not in `targets` and not judged.
+    pub targets_before_resume: Vec<TargetBeforeResume>,
     /// Every target within 100 m, the final point or the lead within 100 m, and the
     /// flown plan ended before the time limit.
     pub completed: bool,
@@ -216,6 +230,7 @@ struct PathMetrics {
     exposure: f64,
     threats: Vec<ThreatOutcome>,
     targets: Vec<TargetOutcome>,
+    before_resume: Vec<TargetBeforeResume>,
 }
 
 fn path_metrics<const D: usize>(flight: &Flight) -> Result<PathMetrics, ThreatError> {
@@ -256,16 +271,28 @@ fn path_metrics<const D: usize>(flight: &Flight) -> Result<PathMetrics, ThreatEr
     }
     // Targets: each tasking revision's targets on the path flown while it was in force;
     // an earlier revision's target counts only if it was reached before it was replaced.
+    // A resumed flight did not fly to the targets the planner had passed before the
+    // resume: they are listed apart, and the search starts at the first one ahead.
     let revisions = flight.datalink.taskings();
     let mut targets = Vec::new();
+    let mut before_resume = Vec::new();
     for (r, rev) in revisions.iter().enumerate() {
+        let skip = match flight.resumed {
+            Some(res) if res.matched.revision == rev.tasking.revision => res.matched.passed,
+            _ => 0,
+        };
+        let all = rev.tasking.targets();
+        let skip = skip.min(all.len());
+        before_resume.extend(all[..skip].iter().map(|p| TargetBeforeResume {
+            position_m: *p,
+            revision: rev.tasking.revision,
+        }));
+        let ahead = &all[skip..];
         let from = times.partition_point(|&t| t < rev.at_s);
         let to = revisions.get(r + 1).map_or(times.len(), |next| {
             times.partition_point(|&t| t < next.at_s)
         });
-        let list: Vec<[f64; D]> = rev
-            .tasking
-            .targets()
+        let list: Vec<[f64; D]> = ahead
             .iter()
             .map(|p| std::array::from_fn(|i| p[i]))
             .collect();
@@ -281,7 +308,7 @@ fn path_metrics<const D: usize>(flight: &Flight) -> Result<PathMetrics, ThreatEr
         for (j, miss) in out.iter().take(n).enumerate() {
             let passed = miss.distance <= REACHED_M;
             if last || passed {
-                let p = rev.tasking.targets()[j];
+                let p = ahead[j];
                 targets.push(TargetOutcome {
                     position_m: p,
                     miss_m: miss.distance,
@@ -296,6 +323,7 @@ fn path_metrics<const D: usize>(flight: &Flight) -> Result<PathMetrics, ThreatEr
         exposure,
         threats,
         targets,
+        before_resume,
     })
 }
 
@@ -395,6 +423,8 @@ pub fn build(flight: &Flight) -> Result<Report, ThreatError> {
         objective: sc.objective.name().to_string(),
         clock: flight.clock.to_string(),
         vehicle_id: flight.vehicle_id.clone(),
+        resumed_at_s: flight.resumed.map(|r| r.point.t_s),
+        targets_before_resume: m.before_resume,
         completed,
         end: if plan_ended {
             "plan-ended"

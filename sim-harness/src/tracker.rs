@@ -103,6 +103,18 @@ impl InnerLoop {
         self.select();
     }
 
+    /// Starts the tracker on `plan` at mission time `t` (a resumed flight): the state and
+    /// control are the plan's at `t`, the plan is the flown one (once its start and
+    /// availability have come).
+    pub fn start_on(&mut self, t: f64, plan: ReceivedPlan) {
+        let (x, u) = reference(&plan.plan, t);
+        self.t = t;
+        self.state = x;
+        self.control = u;
+        self.receive(plan);
+        self.update_deviation();
+    }
+
     /// Every plan received, in order.
     pub fn plans(&self) -> &[ReceivedPlan] {
         &self.plans

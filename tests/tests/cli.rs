@@ -62,3 +62,14 @@ fn planner_checks_a_scenario_and_refuses_a_broken_one() {
         "{err}"
     );
 }
+
+#[test]
+fn harness_refuses_to_resume_without_an_external_planner() {
+    let out = Command::new(binary("wingman-harness"))
+        .args(["fly", "2d-min-time-avoidable", "--resume"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(err.contains("it needs --planner external"), "{err}");
+}

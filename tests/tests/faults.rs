@@ -12,6 +12,8 @@ use std::time::Duration;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use service_support::{FakeHarness, scenario_threats, static_threat, tasking_from};
+use wingman_harness::flight_log::{self, Direction, Entry, Kind};
+use wingman_harness::tracker::reference;
 use wingman_interfaces::*;
 use wingman_planner::scenario::bundled;
 use wingman_planner::service::ipc::{self, Ipc};
@@ -404,43 +406,193 @@ fn a_harness_killed_mid_flight_leaves_the_planner_running_and_reporting_stale_in
     assert!(p.terminate(Duration::from_secs(30)).success());
 }
 
-/// After its harness was killed, the planner serves a new harness process that flies the
-/// mission again from its start (a new mission clock, the same tasking revision).
+/// After its harness was killed (`kill -9`, at about 2 s of mission time), the planner
+/// serves a new harness process that resumes the mission (`fly --resume`): the new harness
+/// starts at the planner's mission time on its current plan, the planner takes its inputs
+/// (no rejection; the stale ownship bit clears), the mission completes, and a pop-up the
+/// new harness reports at 40 s (`--popup-burst-at 40 --popup-burst-count 1`, on the plan
+/// ahead) is re-planned by the planner that kept running (plan ids continuing above the
+/// resumed one). The planner then stops cleanly.
 ///
-/// Protection: the planner taking a new peer's inputs. Today the service refuses them:
-/// the new harness's mission clock restarts at 0 (per-sender "time going backwards"), its
-/// tasking revision 1 is not newer than the one held, and the new harness's lock-step wait
-/// times out. Needs a notion of a new session in the contract (or the service accepting a
-/// restarted peer); reported to the service's owner.
+/// Protections: the resume point — mission time and input sequence continued from the
+/// planner's status (a new harness whose clock restarts at 0 has every input refused as
+/// time going backwards: `messages_rejected` grows and no pop-up plan comes; one whose
+/// sequence restarts passes the lock-step barrier before the planner has read its inputs,
+/// and the planner's highest sequence no longer counts the new inputs on from the old);
+/// the world replayed to the resume time (tasking and route repeats: no `Tasking` or
+/// `Initial` re-plan) and the tracker started on the current plan (its first ownship
+/// state, read from `flight.log`, is the plan's state at the resume time). Without
+/// `--resume` (the harness flying the mission again from its start) this test fails.
 #[test]
-#[ignore = "service: a new harness whose mission clock restarts is not served (time-backwards / stale tasking revision); see the doc"]
 fn a_harness_killed_mid_flight_is_replaced_by_a_new_one_the_planner_serves() {
     let dir = TempDir::new("new-harness");
     let v = vehicle("newharness");
     let (mut p, mut watch) = kill_the_harness(&dir, &v);
-    assert!(watch.wait(WAIT, |s| s.stale_inputs & STALE_OWNSHIP != 0));
+    assert!(
+        watch.wait(WAIT, |s| s.stale_inputs & STALE_OWNSHIP != 0),
+        "no stale ownship reported: {:?}",
+        watch.last
+    );
     let s = watch.last.unwrap();
+    let planner_s = s.header.mission_time_ns as f64 * 1e-9;
     let second = dir.path().join("second");
-    let o = harness(&[
+    let hx = harness(&[
         "fly",
         "2d-min-time-avoidable",
+        "--resume",
+        "--quiet",
+        "--planner",
+        "external",
+        "--vehicle",
+        &v,
+        "--popup-burst-at",
+        "40",
+        "--popup-burst-count",
+        "1",
+        "--out",
+        second.to_str().unwrap(),
+    ]);
+    // Served while it flies: the new harness's inputs are fresh again.
+    assert!(
+        watch.wait(WAIT, |st| st.stale_inputs == 0
+            && st.messages_received > s.messages_received),
+        "the planner never saw the new harness's inputs fresh: {:?}",
+        watch.last
+    );
+    let o = hx.wait(FLIGHT);
+    assert!(o.status.success(), "{}", text(&o));
+    let r = report(&second);
+    let resumed = r["resumed_at_s"].as_f64().expect("resumed_at_s");
+    assert!(
+        resumed >= planner_s - 1e-6 && resumed <= planner_s + 0.1 + 1e-6,
+        "resumed at {resumed} s, the planner was at {planner_s} s"
+    );
+    assert!(
+        resumed < 40.0,
+        "the kill came too late for the pop-up: {resumed} s"
+    );
+    assert_mission_succeeded(&r);
+    assert_every_tr_followed(&r);
+    let rows = plans(&r);
+    let ids: Vec<u64> = r["plans"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["plan_id"].as_u64().unwrap())
+        .collect();
+    assert_eq!(
+        ids[0], s.current_plan_id,
+        "resumed on another plan: {rows:?}"
+    );
+    assert_eq!(r["plans"][0]["flown"], true);
+    // The aircraft took up the flight on the plan: the new harness's first ownship state
+    // is the resumed plan's state at the resume time (1 m; the plan's own interpolation).
+    let log = flight_log::read(&second.join("flight.log")).unwrap();
+    let plan = log
+        .iter()
+        .find_map(|e| match e {
+            Entry::Message {
+                direction: Direction::FromPlanner,
+                kind: Kind::Plan,
+                bytes,
+                ..
+            } => flight_log::decode_plan(bytes),
+            _ => None,
+        })
+        .expect("the resumed plan in flight.log");
+    let own: OwnshipState = log
+        .iter()
+        .find_map(|e| match e {
+            Entry::Message {
+                direction: Direction::ToPlanner,
+                kind: Kind::OwnshipState,
+                bytes,
+                ..
+            } => flight_log::decode(bytes),
+            _ => None,
+        })
+        .expect("an ownship state in flight.log");
+    assert_eq!(plan.plan_id, s.current_plan_id);
+    assert_eq!(own.plan_id, plan.plan_id);
+    assert!((own.time_s - resumed).abs() < 1e-9);
+    let (x, _) = reference(&plan, resumed);
+    let off = (own.state[0] - x[0]).hypot(own.state[1] - x[1]);
+    assert!(off < 1.0, "the aircraft resumed {off} m off the plan");
+    let after = &rows[1..];
+    assert!(
+        !after.is_empty()
+            && after
+                .iter()
+                .all(|p| p.trigger == "PopUp" && (40.0..41.0).contains(&p.at_s)),
+        "the planner's plans after the resume are the pop-up's only: {rows:?}"
+    );
+    assert_eq!(ids[1], s.current_plan_id + 1, "plan ids: {ids:?}");
+    let counters = &r["planner"];
+    assert_eq!(
+        counters["messages_rejected"].as_u64().unwrap(),
+        s.messages_rejected,
+        "the new harness's inputs were refused"
+    );
+    assert_eq!(
+        counters["plans_made"].as_u64().unwrap(),
+        s.plans_made + after.len() as u64
+    );
+    assert_eq!(r["rejected_messages"].as_u64().unwrap(), 0);
+    // The input sequence went on from the planner's: every input of the new harness was
+    // processed, numbered on from the last one the planner had.
+    let received = counters["messages_received"].as_u64().unwrap();
+    assert!(watch.wait(WAIT, |st| st.messages_received >= received));
+    let end = watch.last.unwrap();
+    assert_eq!(
+        end.last_input_sequence,
+        s.last_input_sequence + (end.messages_received - s.messages_received),
+        "the sequence did not continue: {s:?} then {end:?}"
+    );
+    assert!(
+        r["targets_before_resume"].as_array().unwrap().is_empty(),
+        "the target lies ahead of a resume at {resumed} s"
+    );
+    assert!(p.is_running(), "the planner died");
+    assert!(p.terminate(Duration::from_secs(30)).success());
+}
+
+/// `fly --resume` of another scenario than the planner flies is refused with an error
+/// naming the difference (here a 3-D scenario against a 2-D plan), exit code 1; the
+/// planner is left as it was (no input sent, so nothing rejected, and still running).
+///
+/// Protection: the check of the planner's plan against the scenario before anything is
+/// sent (without it the harness publishes a 3-D tasking into a 2-D mission).
+#[test]
+fn resuming_a_planner_that_flies_another_mission_is_refused() {
+    let dir = TempDir::new("resume-other");
+    let (mut p, mut h, v) = planner_with_first_plan(&dir, "resumeother", "");
+    let before = h.last_status();
+    let o = harness(&[
+        "fly",
+        "3d-min-time-avoidable",
+        "--resume",
         "--quiet",
         "--planner",
         "external",
         "--vehicle",
         &v,
         "--out",
-        second.to_str().unwrap(),
+        dir.path().join("run").to_str().unwrap(),
     ])
-    .wait(FLIGHT);
-    assert!(o.status.success(), "{}", text(&o));
-    let r = report(&second);
-    assert_mission_succeeded(&r);
+    .wait(WAIT);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    let err = String::from_utf8_lossy(&o.stderr);
     assert!(
-        r["planner"]["messages_rejected"].as_u64().unwrap() == s.messages_rejected,
-        "the new harness's inputs were refused"
+        err.contains("the planner flies another mission than `3d-min-time-avoidable`")
+            && err.contains("is 2-D, the scenario is 3-D"),
+        "{err}"
     );
-    assert!(p.is_running());
+    std::thread::sleep(Duration::from_millis(300));
+    h.poll();
+    let after = h.last_status();
+    assert_eq!(after.messages_received, before.messages_received);
+    assert_eq!(after.plans_made, before.plans_made);
+    assert!(p.is_running(), "the planner died");
     assert!(p.terminate(Duration::from_secs(30)).success());
 }
 
