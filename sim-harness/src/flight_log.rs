@@ -226,6 +226,28 @@ pub fn read(path: &Path) -> Result<Vec<Entry>, LogError> {
     }
 }
 
+/// The logged bytes of every message of `kind` that went `direction`, in log order.
+pub fn messages(
+    entries: &[Entry],
+    direction: Direction,
+    kind: Kind,
+) -> impl Iterator<Item = &[u8]> + '_ {
+    entries.iter().filter_map(move |e| match e {
+        Entry::Message {
+            direction: d,
+            kind: k,
+            bytes,
+            ..
+        } if *d == direction && *k == kind => Some(bytes.as_slice()),
+        _ => None,
+    })
+}
+
+/// Every plan the harness took, in log order (a plan of the wrong length is skipped).
+pub fn plans(entries: &[Entry]) -> impl Iterator<Item = Box<Plan>> + '_ {
+    messages(entries, Direction::FromPlanner, Kind::Plan).filter_map(decode_plan)
+}
+
 /// A message of type `M` from its logged bytes (`None` if the length is wrong).
 pub fn decode<M: Wire>(bytes: &[u8]) -> Option<M> {
     M::read_from_bytes(bytes).ok()

@@ -22,7 +22,7 @@ use wingman_interfaces::{Plan, Wire};
 use wingman_planner::clock::MonotonicClock;
 use wingman_planner::service::{RunOptions, ServiceConfig, Shutdown};
 
-use crate::flight_log::{self, Direction, Entry, Kind, LogWriter};
+use crate::flight_log::{self, Direction, Entry, LogWriter};
 use crate::link::PlannerLink;
 use crate::mission::unique_vehicle_id;
 
@@ -215,18 +215,7 @@ pub fn replay(log: &Path, timeout: Duration) -> Result<ReplayOutcome, ReplayErro
     let mut config = ServiceConfig::from_toml(&config_text, "flight.log (planner_config)")?;
     config.vehicle_id = unique_vehicle_id("replay");
     let lock_step = entries.iter().any(|e| matches!(e, Entry::Sync { .. }));
-    let logged: Vec<Box<Plan>> = entries
-        .iter()
-        .filter_map(|e| match e {
-            Entry::Message {
-                direction: Direction::FromPlanner,
-                kind: Kind::Plan,
-                bytes,
-                ..
-            } => flight_log::decode_plan(bytes),
-            _ => None,
-        })
-        .collect();
+    let logged: Vec<Box<Plan>> = flight_log::plans(&entries).collect();
 
     let mut link = PlannerLink::open(&config.vehicle_id, LogWriter::discard())?;
     let mut planner = InProcessPlanner::start(config)?;

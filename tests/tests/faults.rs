@@ -12,7 +12,7 @@ use std::time::Duration;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use service_support::{FakeHarness, scenario_threats, static_threat, tasking_from};
-use wingman_harness::flight_log::{self, Direction, Entry, Kind};
+use wingman_harness::flight_log::{self, Direction, Kind};
 use wingman_harness::tracker::reference;
 use wingman_interfaces::*;
 use wingman_planner::scenario::bundled;
@@ -488,29 +488,11 @@ fn a_harness_killed_mid_flight_is_replaced_by_a_new_one_the_planner_serves() {
     // The aircraft took up the flight on the plan: the new harness's first ownship state
     // is the resumed plan's state at the resume time (1 m; the plan's own interpolation).
     let log = flight_log::read(&second.join("flight.log")).unwrap();
-    let plan = log
-        .iter()
-        .find_map(|e| match e {
-            Entry::Message {
-                direction: Direction::FromPlanner,
-                kind: Kind::Plan,
-                bytes,
-                ..
-            } => flight_log::decode_plan(bytes),
-            _ => None,
-        })
+    let plan = flight_log::plans(&log)
+        .next()
         .expect("the resumed plan in flight.log");
-    let own: OwnshipState = log
-        .iter()
-        .find_map(|e| match e {
-            Entry::Message {
-                direction: Direction::ToPlanner,
-                kind: Kind::OwnshipState,
-                bytes,
-                ..
-            } => flight_log::decode(bytes),
-            _ => None,
-        })
+    let own: OwnshipState = flight_log::messages(&log, Direction::ToPlanner, Kind::OwnshipState)
+        .find_map(flight_log::decode)
         .expect("an ownship state in flight.log");
     assert_eq!(plan.plan_id, s.current_plan_id);
     assert_eq!(own.plan_id, plan.plan_id);
