@@ -6,7 +6,10 @@
 //!
 //! Overrides: `PROBE_STARTS`, `PROBE_FINALISTS`, `PROBE_ROUNDS`, `PROBE_RANK_PTS`,
 //! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`,
-//! `PROBE_NLP="name=value;name=value"` (extra solver options).
+//! `PROBE_NLP="name=value;name=value"` (extra solver options; `PROBE_RANK_NLP` and
+//! `PROBE_FINAL_NLP` for the ranking or the working-mesh solves only); `PROBE_FIRST_SEED` (1);
+//! `PROBE_OUT=DIR` writes
+//! each plan's `plan.json` / `plan.csv` into `DIR/NAME-SEED/` for the judge.
 
 use std::time::Duration;
 
@@ -74,6 +77,13 @@ fn main() {
             }
         }
     }
+    if let Ok(extra) = std::env::var("PROBE_FINAL_NLP") {
+        for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
+            if let Some((k, v)) = kv.split_once('=') {
+                s.nlp.extra.push((k.to_string(), v.to_string()));
+            }
+        }
+    }
     if let Ok(extra) = std::env::var("PROBE_RANK_NLP") {
         for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
             if let Some((k, v)) = kv.split_once('=') {
@@ -98,12 +108,14 @@ fn main() {
         // One planner per scenario, as the service keeps one: its workspace and its
         // estimate of the NLP's set-up time carry over from plan to plan.
         let mut planner = Planner::new(&s);
-        for seed in 1..=runs {
+        let first = env::<u64>("PROBE_FIRST_SEED").unwrap_or(1);
+        for seed in first..first + runs {
             let st = PlannerSettings {
                 swarm: s.swarm.clone().with_seed(seed),
                 ..s.clone()
             };
             let budget_ms = env::<u64>("PROBE_DEADLINE_MS").unwrap_or(30_000);
+            eprintln!("PLAN {name} {seed}");
             let began = std::time::Instant::now();
             let out = planner
                 .plan(
@@ -121,6 +133,13 @@ fn main() {
                     out.times.nlp.as_secs_f64() * 1e3,
                     out.times.export.as_secs_f64() * 1e3,
                 );
+            }
+            if let Ok(dir) = std::env::var("PROBE_OUT") {
+                // The judge's inputs: `tools/judge/evaluate.py SCENARIO DIR/NAME-SEED/plan.csv`.
+                let dir = std::path::Path::new(&dir).join(format!("{name}-{seed}"));
+                std::fs::create_dir_all(&dir).unwrap();
+                let sc = bundled(name).unwrap().unwrap();
+                wingman_planner::offline::write_outputs(&dir, &sc, &problem, &out).unwrap();
             }
             let ratio = out.cost / reference;
             ratios.push(ratio);

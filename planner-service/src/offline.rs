@@ -142,7 +142,8 @@ fn quality_name(q: Quality) -> &'static str {
     q.name()
 }
 
-fn write_outputs(
+/// Writes `plan.json` and `plan.csv` (the judge's format) of `outcome` into `dir`.
+pub fn write_outputs(
     dir: &Path,
     sc: &Scenario,
     problem: &Problem,

@@ -282,10 +282,17 @@ fn the_unit_file_and_the_deployment_doc_match_the_binary() {
     }
 
     // T8: every flag the documents mention is one `serve` has, except on the lines of
-    // other commands (cargo, the install steps, systemd's tools).
+    // other commands (cargo, the install steps, systemd's tools, the harness).
     let doc = std::fs::read_to_string(repo().join("docs/DEPLOYMENT.md")).unwrap();
     let toml = std::fs::read_to_string(repo().join("planner.toml")).unwrap();
-    let other = ["cargo ", "sudo ", "journalctl", "systemctl", "useradd"];
+    let other = [
+        "cargo ",
+        "sudo ",
+        "journalctl",
+        "systemctl",
+        "useradd",
+        "wingman-harness ",
+    ];
     let mut commands = 0;
     for (file, text) in [
         ("DEPLOYMENT.md", &doc),
