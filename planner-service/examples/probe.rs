@@ -47,9 +47,11 @@ fn main() {
     }
     if let Some(v) = env("PROBE_RANK_PTS") {
         s.ranking_mesh.points = v;
+        s.ranking_mesh_3d.points = v;
     }
     if let Some(v) = env("PROBE_RANK_S") {
         s.ranking_mesh.interval_s = v;
+        s.ranking_mesh_3d.interval_s = v;
     }
     if let Some(v) = env("PROBE_MESH_PTS") {
         s.mesh.points = v;
