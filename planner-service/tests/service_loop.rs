@@ -347,14 +347,7 @@ fn a_restarted_planner_waits_for_the_ownship_before_its_first_plan() {
     let mut cfg = test_config(&vehicle("restart-wait"));
     cfg.triggers.first_plan_wait_ms = 60_000;
     let mut d = Driven::new(cfg);
-    let sc = wingman_planner::scenario::bundled("2d-min-time-avoidable")
-        .unwrap()
-        .unwrap();
-    d.h.set_time(0.0);
-    for t in scenario_threats(&sc) {
-        d.h.send_threat(t);
-    }
-    d.h.send_tasking(tasking_from(&sc, 1));
+    d.send_scenario("2d-min-time-avoidable");
     for _ in 0..5 {
         d.pass();
         std::thread::sleep(Duration::from_millis(5));
@@ -394,4 +387,38 @@ fn a_first_plan_without_an_ownship_state_starts_after_the_wait() {
     let p = &d.h.plans[0];
     assert_eq!(p.trigger(), Some(Trigger::Initial));
     assert_eq!(p.start_time_s, 0.0);
+}
+
+/// B9: a first plan that waits for an ownship state keeps the status `Planning` until it
+/// has started, also between the end of that wait and the pass that starts the plan (the
+/// status of that window said `Degraded`: a lock-step harness reading it went on as if
+/// nothing were due, and `first_plan` here saw no plan). Protection: `first_plan_due` in
+/// the status's `Planning` condition.
+#[test]
+fn a_first_plan_is_planning_from_its_tasking_until_it_has_started() {
+    let cfg = test_config(&vehicle("first-due"));
+    let wait = Duration::from_millis(cfg.triggers.first_plan_wait_ms);
+    let mut d = Driven::new(cfg);
+    d.send_scenario("2d-min-time-avoidable");
+    d.pass();
+    assert_eq!(
+        d.status().state(),
+        Some(PlannerState::Planning),
+        "waiting for an ownship state"
+    );
+    // The wait is over and no pass has run since: the plan is due, not started.
+    std::thread::sleep(wait + Duration::from_millis(50));
+    let s = d.status();
+    assert_eq!(s.plans_made, 0);
+    assert_eq!(
+        s.state(),
+        Some(PlannerState::Planning),
+        "a first plan is due"
+    );
+    d.settle();
+    assert_eq!(
+        d.status().plans_made,
+        1,
+        "the first plan, from the tasking's start"
+    );
 }

@@ -435,6 +435,19 @@ impl MessageLoop {
         }
     }
 
+    /// A first plan is due: the tasking (and a rendezvous's route) is here and no failed
+    /// first plan waits for its retry. It starts at the next pass once no longer
+    /// [waiting for an ownship state](Self::waiting_for_ownship).
+    fn first_plan_due(&self) -> bool {
+        let Some(t) = &self.world.tasking else {
+            return false;
+        };
+        let needs_route = t.objective() == Some(Objective::MinTimeRendezvous);
+        self.awaiting_first
+            && self.retry_first_at.is_none_or(|at| self.clock.now() >= at)
+            && (!needs_route || self.world.route.is_some())
+    }
+
     /// A first plan waits for an ownship state (see `first_wait_until`).
     fn waiting_for_ownship(&self) -> bool {
         self.awaiting_first
@@ -824,19 +837,14 @@ impl MessageLoop {
     fn evaluate(&mut self) -> bool {
         let now = self.world.now_s();
         let lead = self.budget().as_secs_f64();
-        let retry_due = self.retry_first_at.is_none_or(|at| self.clock.now() >= at);
-        if self.awaiting_first
-            && retry_due
+        if self.first_plan_due()
             && !self.waiting_for_ownship()
             && let Some(t) = &self.world.tasking
         {
-            let needs_route = t.objective() == Some(Objective::MinTimeRendezvous);
-            if !needs_route || self.world.route.is_some() {
-                let trigger = triggers::first_plan_trigger(t, self.world.ownship.as_ref());
-                self.awaiting_first = false;
-                self.retry_first_at = None;
-                self.raise(trigger);
-            }
+            let trigger = triggers::first_plan_trigger(t, self.world.ownship.as_ref());
+            self.awaiting_first = false;
+            self.retry_first_at = None;
+            self.raise(trigger);
         }
         let quiet = self.in_flight.is_none() && self.pending.set.is_empty();
         if self.has_plan && quiet && self.batch.is_empty() {
@@ -1251,11 +1259,13 @@ impl MessageLoop {
         let wall = self.clock.now();
         let stale = self.world.stale_bits(wall, &self.cfg.staleness);
         // `Planning` also while a triggered plan waits for the compute gate, or a first
-        // plan for an ownship state: a lock-step harness then waits for it as for a plan
-        // in flight.
+        // plan is due (waiting for an ownship state, or about to start at the next pass
+        // once that wait is over): a lock-step harness then waits for it as for a plan in
+        // flight.
         let state = if self.in_flight.is_some()
             || !self.pending.set.is_empty()
             || self.waiting_for_ownship()
+            || self.first_plan_due()
         {
             PlannerState::Planning
         } else if stale != 0

@@ -394,14 +394,20 @@ impl Driven {
     }
 
     /// Sends the threats known at take-off and the tasking of scenario `name` at mission
-    /// time 0, and settles on the first plan.
-    pub fn first_plan(&mut self, name: &str) -> Scenario {
+    /// time 0 (no pass).
+    pub fn send_scenario(&mut self, name: &str) -> Scenario {
         let sc = wingman_planner::scenario::bundled(name).unwrap().unwrap();
         self.h.set_time(0.0);
         for t in scenario_threats(&sc) {
             self.h.send_threat(t);
         }
         self.h.send_tasking(tasking_from(&sc, 1));
+        sc
+    }
+
+    /// [`Driven::send_scenario`], then settles on the first plan.
+    pub fn first_plan(&mut self, name: &str) -> Scenario {
+        let sc = self.send_scenario(name);
         self.settle();
         assert_eq!(self.status().plans_made, 1, "no first plan");
         assert_eq!(self.h.plans.len(), 1);
