@@ -19,7 +19,7 @@ use wingman_planner::scenario::bundled;
 use wingman_planner::service::ipc::{self, Ipc};
 use wingman_tests::outcome::{assert_every_tr_followed, assert_mission_succeeded, plans};
 use wingman_tests::process::{
-    TempDir, harness, harness_logging, planner, planner_config, report, text, vehicle,
+    Proc, TempDir, harness, harness_logging, planner, planner_config, report, text, vehicle,
 };
 use wingman_tests::rogue::{Rogue, send_invalid};
 
@@ -436,22 +436,12 @@ fn a_harness_killed_mid_flight_is_replaced_by_a_new_one_the_planner_serves() {
     let s = watch.last.unwrap();
     let planner_s = s.header.mission_time_ns as f64 * 1e-9;
     let second = dir.path().join("second");
-    let hx = harness(&[
-        "fly",
+    let hx = resume(
         "2d-min-time-avoidable",
-        "--resume",
-        "--quiet",
-        "--planner",
-        "external",
-        "--vehicle",
         &v,
-        "--popup-burst-at",
-        "40",
-        "--popup-burst-count",
-        "1",
-        "--out",
-        second.to_str().unwrap(),
-    ]);
+        &second,
+        &["--popup-burst-at", "40", "--popup-burst-count", "1"],
+    );
     // Served while it flies: the new harness's inputs are fresh again.
     assert!(
         watch.wait(WAIT, |st| st.stale_inputs == 0
@@ -538,6 +528,26 @@ fn a_harness_killed_mid_flight_is_replaced_by_a_new_one_the_planner_serves() {
     assert!(p.terminate(Duration::from_secs(30)).success());
 }
 
+/// `wingman-harness fly SCENARIO --resume` against the external planner of vehicle `v`,
+/// quiet, writing into `out`, with `extra` arguments.
+fn resume(scenario: &str, v: &str, out: &std::path::Path, extra: &[&str]) -> Proc {
+    let out = out.to_str().unwrap();
+    let mut args = vec![
+        "fly",
+        scenario,
+        "--resume",
+        "--quiet",
+        "--planner",
+        "external",
+        "--vehicle",
+        v,
+        "--out",
+        out,
+    ];
+    args.extend_from_slice(extra);
+    harness(&args)
+}
+
 /// `fly --resume` of another scenario than the planner flies is refused with an error
 /// naming the difference (here a 3-D scenario against a 2-D plan), exit code 1; the
 /// planner is left as it was (no input sent, so nothing rejected, and still running).
@@ -549,19 +559,7 @@ fn resuming_a_planner_that_flies_another_mission_is_refused() {
     let dir = TempDir::new("resume-other");
     let (mut p, mut h, v) = planner_with_first_plan(&dir, "resumeother", "");
     let before = h.last_status();
-    let o = harness(&[
-        "fly",
-        "3d-min-time-avoidable",
-        "--resume",
-        "--quiet",
-        "--planner",
-        "external",
-        "--vehicle",
-        &v,
-        "--out",
-        dir.path().join("run").to_str().unwrap(),
-    ])
-    .wait(WAIT);
+    let o = resume("3d-min-time-avoidable", &v, &dir.path().join("run"), &[]).wait(WAIT);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
