@@ -12,6 +12,7 @@
 //! - [`budget`]: the compute gate (minimum spacing, duty-cycle cap);
 //! - [`solver`]: the solve thread that owns the hybrid planner;
 //! - [`export`]: the `Plan` message from a planned trajectory, and back to trigger points;
+//! - [`sched`]: the message thread's short scheduler slice (a message wakes it at once);
 //! - [`run`]: the message thread and [`run()`](run::run), which `wingman-planner serve`
 //!   calls and a test can drive in-process.
 
@@ -20,6 +21,7 @@ pub mod config;
 pub mod export;
 pub mod ipc;
 pub mod run;
+pub mod sched;
 pub mod solver;
 pub mod triggers;
 pub mod world;

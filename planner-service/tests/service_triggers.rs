@@ -389,6 +389,14 @@ fn a_bad_configuration_is_refused_naming_the_key() {
     assert!(e.to_string().contains("budget.duty_cycle"), "{e}");
     let e = ServiceConfig::from_toml("vehicle_id = \"a/b\"\n", "x.toml").unwrap_err();
     assert!(e.to_string().contains("vehicle_id"), "{e}");
+    let e =
+        ServiceConfig::from_toml("[scheduling]\nmessage_slice_us = 50\n", "x.toml").unwrap_err();
+    assert!(e.to_string().contains("scheduling.message_slice_us"), "{e}");
+    for us in [0, 100, 100_000] {
+        let ok = ServiceConfig::from_toml(&format!("[scheduling]\nmessage_slice_us = {us}\n"), "x")
+            .unwrap();
+        assert_eq!(ok.scheduling.message_slice_us, us);
+    }
     let ok = ServiceConfig::from_toml("[budget]\nplan_2d_ms = 90\n", "x.toml").unwrap();
     assert_eq!(ok.budget.plan_2d_ms, 90);
     assert_eq!(

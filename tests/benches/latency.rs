@@ -9,7 +9,9 @@
 //!
 //! Options (after `--`): `--quick`; `--budget-2d-ms N`, `--budget-3d-ms N` (the planner's
 //! budgets, default 500 / 2500 ms as in `planner.toml`); `--out FILE` (default
-//! `docs/benchmarks/latency.json`).
+//! `docs/benchmarks/latency.json`); `--round-trip-only` (the small raw round trip and the
+//! service's, both conditions, ~1 min: an A/B of the message path); `--message-slice-us N`
+//! (the planner's `scheduling.message_slice_us`, default its own default).
 //!
 //! What runs, in each condition (`idle`, then `loaded`):
 //! - `raw_iceoryx2_small` / `raw_iceoryx2_plan`: this process publishes a message the size
@@ -52,6 +54,7 @@ use wingman_interfaces::*;
 use wingman_planner::scenario::bundled;
 use wingman_planner::service::export::state_at;
 use wingman_planner::service::ipc::{self, Ipc};
+use wingman_planner::service::sched;
 use wingman_tests::process::{Proc, TempDir, planner};
 
 /// Cores both processes (and the hog) run on.
@@ -79,6 +82,11 @@ struct Options {
     budget_2d_ms: u64,
     budget_3d_ms: u64,
     out: PathBuf,
+    /// Only the small raw round trip and the service's round trip (an A/B of the message
+    /// path in ~1 min).
+    round_trip_only: bool,
+    /// The planner's `scheduling.message_slice_us` (`None`: its default).
+    message_slice_us: Option<u64>,
 }
 
 impl Options {
@@ -90,10 +98,19 @@ impl Options {
     }
     fn trigger_samples(&self, model: Model) -> usize {
         match (self.quick, model) {
+            _ if self.round_trip_only => 0,
             (true, _) => 5,
             (false, Model::TwoD) => 50,
             (false, Model::ThreeD) => 30,
         }
+    }
+    /// The message threads' scheduler slice, µs (0: the kernel's default).
+    fn slice_us(&self) -> u64 {
+        self.message_slice_us.unwrap_or(
+            wingman_planner::service::ServiceConfig::default()
+                .scheduling
+                .message_slice_us,
+        )
     }
     fn budget_ms(&self, model: Model) -> u64 {
         match model {
@@ -108,6 +125,7 @@ fn main() {
     match args.first().map(String::as_str) {
         Some("--echo") => {
             let (ping, pong, kind) = (arg(&args, 1), arg(&args, 2), arg(&args, 3));
+            let _slice = Slice::set(arg(&args, 4).parse().expect("--echo slice µs"));
             match kind {
                 "small" => echo::<OwnshipState>(ping, pong),
                 "plan" => echo::<Plan>(ping, pong),
@@ -127,6 +145,8 @@ fn main() {
         budget_2d_ms: 500,
         budget_3d_ms: 2500,
         out: Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/benchmarks/latency.json"),
+        round_trip_only: false,
+        message_slice_us: None,
     };
     let mut k = 0;
     while k < args.len() {
@@ -139,6 +159,11 @@ fn main() {
             "--budget-3d-ms" => {
                 k += 1;
                 o.budget_3d_ms = arg(&args, k).parse().expect("--budget-3d-ms N");
+            }
+            "--round-trip-only" => o.round_trip_only = true,
+            "--message-slice-us" => {
+                k += 1;
+                o.message_slice_us = Some(arg(&args, k).parse().expect("--message-slice-us N"));
             }
             "--out" => {
                 k += 1;
@@ -267,18 +292,37 @@ fn run(o: &Options) {
         );
         results.insert(
             ("raw_iceoryx2_small", cond),
-            raw::<OwnshipState>(&format!("{tag}s"), "small", o.raw_samples(), |m, s| {
-                m.header.sequence = s;
-            }),
+            raw::<OwnshipState>(
+                &format!("{tag}s"),
+                "small",
+                o.slice_us(),
+                o.raw_samples(),
+                |m, s| {
+                    m.header.sequence = s;
+                },
+            ),
         );
-        println!("[{cond}] raw iceoryx2, plan ({} B)", size_of::<Plan>());
-        results.insert(
-            ("raw_iceoryx2_plan", cond),
-            raw::<Plan>(&format!("{tag}p"), "plan", o.raw_samples(), |m, s| {
-                m.header.sequence = s;
-            }),
-        );
-        for model in [Model::TwoD, Model::ThreeD] {
+        if !o.round_trip_only {
+            println!("[{cond}] raw iceoryx2, plan ({} B)", size_of::<Plan>());
+            results.insert(
+                ("raw_iceoryx2_plan", cond),
+                raw::<Plan>(
+                    &format!("{tag}p"),
+                    "plan",
+                    o.slice_us(),
+                    o.raw_samples(),
+                    |m, s| {
+                        m.header.sequence = s;
+                    },
+                ),
+            );
+        }
+        let models: &[Model] = if o.round_trip_only {
+            &[Model::TwoD]
+        } else {
+            &[Model::TwoD, Model::ThreeD]
+        };
+        for &model in models {
             let (rt, trig) = service(o, &format!("{tag}m{}", model as u32), model, cond);
             if let Some(rt) = rt {
                 results.insert(("service_round_trip", cond), rt);
@@ -287,7 +331,9 @@ fn run(o: &Options) {
                 Model::TwoD => "trigger_to_plan_2d",
                 Model::ThreeD => "trigger_to_plan_3d",
             };
-            results.insert((name, cond), trig);
+            if !o.round_trip_only {
+                results.insert((name, cond), trig);
+            }
         }
     }
     let elapsed = started.elapsed();
@@ -388,10 +434,24 @@ fn report(
         }
     }
     let doc = json!({
-        "command": format!(
-            "cargo bench -p wingman-tests --bench latency{}",
-            if o.quick { " -- --quick" } else { "" }
-        ),
+        "command": format!("cargo bench -p wingman-tests --bench latency{}", {
+            let mut a = String::new();
+            if o.quick {
+                a += " --quick";
+            }
+            if o.round_trip_only {
+                a += " --round-trip-only";
+            }
+            if let Some(us) = o.message_slice_us {
+                let _ = write!(a, " --message-slice-us {us}");
+            }
+            if a.is_empty() { a } else { format!(" --{a}") }
+        }),
+        "message_slice_us": o.slice_us(),
+        "scheduling": "the responder of each round trip runs with the scheduler slice \
+                       `message_slice_us`: the planner's message thread (its planner.toml) \
+                       and the raw echo alike; the requester (this bench's thread), the hog \
+                       and the planner's solve thread keep the kernel's default",
         "mode": if o.quick { "quick" } else { "full" },
         "date": shell(&["date", "-u", "+%Y-%m-%dT%H:%M:%SZ"]),
         "machine": {
@@ -526,13 +586,14 @@ fn echo<M: Message + 'static>(ping: &str, pong: &str) {
 fn raw<M: Message + 'static>(
     tag: &str,
     kind: &str,
+    slice_us: u64,
     samples: usize,
     set_sequence: fn(&mut M, u64),
 ) -> Series {
     let (ping, pong) = (format!("{tag}a"), format!("{tag}b"));
     let ends = Ends::<M>::open(&ping, &pong, false);
     let mut cmd = Command::new(std::env::current_exe().expect("current_exe"));
-    cmd.args(["--echo", &ping, &pong, kind]);
+    cmd.args(["--echo", &ping, &pong, kind, &slice_us.to_string()]);
     let mut child = Proc::spawn(cmd, "latency echo");
     // The echo notifies once its ports exist.
     let t = Instant::now();
@@ -602,8 +663,12 @@ fn planner_toml(dir: &Path, o: &Options) -> PathBuf {
         format!(
             "[budget]\nplan_2d_ms = {}\nplan_3d_ms = {}\nmin_spacing_ms = {MIN_SPACING_MS}\n\
              duty_cycle = 1.0\nduty_window_ms = {DUTY_WINDOW_MS}\n\n[solver]\nthreads = \
-             {SOLVER_THREADS}\n",
-            o.budget_2d_ms, o.budget_3d_ms
+             {SOLVER_THREADS}\n{}",
+            o.budget_2d_ms,
+            o.budget_3d_ms,
+            o.message_slice_us
+                .map(|us| format!("\n[scheduling]\nmessage_slice_us = {us}\n"))
+                .unwrap_or_default()
         ),
     )
     .expect("write planner.toml");
@@ -769,6 +834,31 @@ fn summary(s: &Series) {
     );
     if !s.compute_ms.is_empty() {
         println!("  the planner's compute and the rest: {}", s.compute_json());
+    }
+}
+
+/// The calling thread's scheduler slice, set for as long as this lives (0: left alone).
+struct Slice(bool);
+
+impl Slice {
+    fn set(us: u64) -> Slice {
+        if us == 0 {
+            return Slice(false);
+        }
+        let out = sched::set_thread_slice(Duration::from_micros(us)).expect("sched_setattr");
+        assert!(
+            matches!(out, sched::SliceOutcome::Applied(_)),
+            "the scheduler slice was not applied ({out:?}); run with --message-slice-us 0"
+        );
+        Slice(true)
+    }
+}
+
+impl Drop for Slice {
+    fn drop(&mut self) {
+        if self.0 {
+            let _ = sched::reset_thread_slice();
+        }
     }
 }
 

@@ -34,6 +34,7 @@ pub struct ServiceConfig {
     pub staleness: StalenessConfig,
     pub status: StatusConfig,
     pub solver: SolverConfig,
+    pub scheduling: SchedulingConfig,
 }
 
 /// Compute budget of one plan, and the limits that keep bursts of triggers from starving
@@ -96,6 +97,16 @@ pub struct StatusConfig {
     pub heartbeat_ms: u64,
 }
 
+/// The message thread's place in the kernel's scheduler (see `service::sched`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SchedulingConfig {
+    /// Fair-scheduler slice of the message thread, µs (100-100000; 0 keeps the kernel's
+    /// default). A short slice lets a message wake the thread at once on a core a busy
+    /// process holds; its CPU share is unchanged. Kernels before 6.12 ignore it.
+    pub message_slice_us: u64,
+}
+
 /// The hybrid planner on the solve thread.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -119,6 +130,7 @@ impl Default for ServiceConfig {
             staleness: StalenessConfig::default(),
             status: StatusConfig::default(),
             solver: SolverConfig::default(),
+            scheduling: SchedulingConfig::default(),
         }
     }
 }
@@ -160,6 +172,14 @@ impl Default for StalenessConfig {
 impl Default for StatusConfig {
     fn default() -> Self {
         StatusConfig { heartbeat_ms: 1000 }
+    }
+}
+
+impl Default for SchedulingConfig {
+    fn default() -> Self {
+        SchedulingConfig {
+            message_slice_us: 100,
+        }
     }
 }
 
@@ -276,6 +296,13 @@ impl ServiceConfig {
         }
         if self.status.heartbeat_ms == 0 {
             return bad("status.heartbeat_ms", "must be positive".into());
+        }
+        let slice = self.scheduling.message_slice_us;
+        if slice != 0 && !(100..=100_000).contains(&slice) {
+            return bad(
+                "scheduling.message_slice_us",
+                format!("must be 0 (the kernel's default) or 100-100000 µs, got {slice}"),
+            );
         }
         let s = &self.staleness;
         if s.lead_ms == 0 || s.ownship_ms == 0 || s.tracks_ms == 0 {

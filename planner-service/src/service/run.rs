@@ -53,6 +53,7 @@ use super::budget::{ComputeGate, GateSettings};
 use super::config::{ConfigError, ServiceConfig};
 use super::export::{self, PlanInfo, PlanPoints};
 use super::ipc::{self, Ipc, IpcError};
+use super::sched::{self, SliceOutcome};
 use super::solver::{SolveRequest, SolveResult, Solver, SolverStartError, Ticket};
 use super::triggers::{
     self, DeviationBounds, PlanWindow, PopupAssessment, RouteDecision, TaskingDecision, TriggerSet,
@@ -135,6 +136,32 @@ pub enum ServiceError {
     WaitSet(String),
 }
 
+/// Gives the calling (message) thread a fair-scheduler slice of `us` µs (0: the kernel's
+/// default), and says in the log what the kernel made of it.
+fn message_thread_slice(us: u64) {
+    if us == 0 {
+        return;
+    }
+    match sched::set_thread_slice(Duration::from_micros(us)) {
+        Ok(SliceOutcome::Applied(d)) => {
+            info!(
+                slice_us = d.as_micros() as u64,
+                "message thread scheduler slice set"
+            )
+        }
+        Ok(SliceOutcome::NotSupported) => warn!(
+            slice_us = us,
+            "this kernel has no per-thread scheduler slice (6.12 or later has): the message \
+             thread keeps the default"
+        ),
+        Ok(SliceOutcome::NotFair(policy)) => info!(
+            policy,
+            "the message thread runs under a real-time policy: its slice is left alone"
+        ),
+        Err(e) => warn!(error = %e, "cannot set the message thread's scheduler slice"),
+    }
+}
+
 /// Runs the planner service until a signal (with `handle_signals`) or a shutdown request:
 /// removes dead iceoryx2 nodes' resources, opens the services of
 /// `config.vehicle_id`, starts the solve thread and waits for events. On the way out it
@@ -151,6 +178,8 @@ pub fn run(options: RunOptions) -> Result<RunSummary, ServiceError> {
         );
     }
     let mut ml = MessageLoop::new(&options)?;
+    // After the solve thread is started: only this thread gets the short slice.
+    message_thread_slice(options.config.scheduling.message_slice_us);
     let listener = ml.listener()?;
     let mode = if options.handle_signals {
         SignalHandlingMode::HandleTerminationRequests
