@@ -120,6 +120,68 @@ fn sigterm_stops_the_service_with_exit_code_0() {
     assert!(err.contains("planner service stopping"), "stderr:\n{err}");
 }
 
+/// The kernel's scheduler slice of each thread of process `pid`, by thread name, ns
+/// (`se.slice` in `/proc/PID/task/TID/sched`; empty on a kernel that does not show it).
+fn thread_slices(pid: u32) -> Vec<(String, u64)> {
+    let mut out = Vec::new();
+    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
+        return out;
+    };
+    for t in tasks.flatten() {
+        let sched = std::fs::read_to_string(t.path().join("sched")).unwrap_or_default();
+        let name = sched.split(' ').next().unwrap_or_default().to_string();
+        let slice = sched
+            .lines()
+            .find(|l| l.starts_with("se.slice"))
+            .and_then(|l| l.split(':').nth(1))
+            .and_then(|v| v.trim().parse().ok());
+        if let Some(slice) = slice {
+            out.push((name, slice));
+        }
+    }
+    out
+}
+
+/// The message thread runs with planner.toml's 0.1 ms scheduler slice (a message wakes it
+/// at once on a busy core); the solve thread keeps the kernel's default. Fails without
+/// `service::sched` applied in `run()`, or if it were applied before the solve thread
+/// starts (the solve thread would inherit it).
+#[test]
+fn the_message_thread_runs_with_the_short_scheduler_slice_and_the_solve_thread_without() {
+    let release = std::fs::read_to_string("/proc/sys/kernel/osrelease").unwrap_or_default();
+    let mut v = release.trim().split(|c: char| !c.is_ascii_digit());
+    let mut num = || v.next().and_then(|x| x.parse::<u32>().ok()).unwrap_or(0);
+    let kernel = (num(), num());
+    let slices = thread_slices(std::process::id());
+    if kernel < (6, 12) || slices.is_empty() {
+        eprintln!("kernel {release}: no per-thread slice to check");
+        return;
+    }
+    let default = slices[0].1;
+    let v = vehicle("slice");
+    let planner = Planner::spawn(&v, &repo().join("planner.toml"));
+    let mut h = FakeHarness::new(&v);
+    assert!(
+        h.wait_until(Duration::from_secs(30), |h| h.status.is_some()),
+        "no heartbeat"
+    );
+    let threads = thread_slices(planner.child.id());
+    let of = |name: &str| {
+        threads
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|&(_, s)| s)
+            .unwrap_or_else(|| panic!("no thread {name} in {threads:?}"))
+    };
+    let configured = wingman_planner::service::ServiceConfig::load(repo().join("planner.toml"))
+        .unwrap()
+        .scheduling
+        .message_slice_us;
+    assert_eq!(of("wingman-planner"), configured * 1000, "{threads:?}");
+    assert_eq!(of("wingman-solve"), default, "{threads:?}");
+    drop(planner);
+}
+
 /// T7: SIGTERM while a plan is in flight: the service finishes that plan, publishes it,
 /// then exits 0.
 #[test]
