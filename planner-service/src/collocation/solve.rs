@@ -66,8 +66,10 @@ pub struct NlpSettings {
     /// on the canonical scenarios.
     pub second_order_check: bool,
     /// The linear solver of the KKT systems: FERAL, or block elimination over the mesh
-    /// intervals ([`super::kkt`]; FERAL where the structure does not hold). The
-    /// restoration phase keeps FERAL either way.
+    /// intervals ([`super::kkt`]; FERAL where the structure does not hold, and for the
+    /// 3-D KKTs, whose border is too large for its dense factorisation to pay). The
+    /// restoration phase keeps FERAL either way. Structured by default: on the canonical
+    /// scenarios (probe, 3 seeds) 2-D plans 13-37 % faster, the same costs.
     pub kkt: KktSolver,
     /// Initial barrier parameter of a cold start (`None`: the solver's default, 0.1).
     pub mu_init: Option<f64>,
@@ -98,7 +100,7 @@ impl Default for NlpSettings {
             feral_static_pivoting: false,
             feral_pivtol: None,
             second_order_check: true,
-            kkt: KktSolver::Feral,
+            kkt: KktSolver::Structured,
             mu_init: None,
             refine_mu_init: 1e-3,
             extra: Vec::new(),
