@@ -193,7 +193,7 @@ fn factorise_and_solve_do_not_allocate() {
         "the transcription's labels fit its KKT"
     );
     let mut rhs = vec![1.0; 2 * dim];
-    let mut round = |solver: &mut StructuredKkt, rhs: &mut [f64]| {
+    let round = |solver: &mut StructuredKkt, rhs: &mut [f64]| {
         solver.values_array_mut().copy_from_slice(&va);
         let status = solver.multi_solve(true, &ia, &ja, 2, rhs, true, (n_c + n_d) as i32);
         assert_eq!(status, ESymSolverStatus::Success);

@@ -665,14 +665,18 @@ mod tests {
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
+    /// A lower-triangle triplet (1-based), its values, its labels and the dense matrix.
+    struct Arrowhead {
+        ia: Vec<Index>,
+        ja: Vec<Index>,
+        va: Vec<f64>,
+        labels: Vec<i32>,
+        k: DMatrix<f64>,
+    }
+
     /// A random symmetric indefinite arrowhead: blocks of `sizes` (each coupled to a few
-    /// border indices), a border of `nb`, indices shuffled over the KKT. The lower-triangle
-    /// triplet (1-based), its values, the labels and the dense matrix.
-    fn arrowhead(
-        sizes: &[usize],
-        nb: usize,
-        rng: &mut ChaCha8Rng,
-    ) -> (Vec<Index>, Vec<Index>, Vec<f64>, Vec<i32>, DMatrix<f64>) {
+    /// border indices), a border of `nb`, indices shuffled over the KKT.
+    fn arrowhead(sizes: &[usize], nb: usize, rng: &mut ChaCha8Rng) -> Arrowhead {
         let dim = sizes.iter().sum::<usize>() + nb;
         let mut order: Vec<usize> = (0..dim).collect();
         for i in (1..dim).rev() {
@@ -727,7 +731,13 @@ mod tests {
                 k[(c, r)] += v;
             }
         }
-        (ia, ja, va, labels, k)
+        Arrowhead {
+            ia,
+            ja,
+            va,
+            labels,
+            k,
+        }
     }
 
     fn feral_cfg() -> FeralConfig {
@@ -773,7 +783,13 @@ mod tests {
             (vec![1, 2, 3], 1),
             (vec![30, 25], 20),
         ] {
-            let (ia, ja, va, labels, k) = arrowhead(&sizes, nb, &mut rng);
+            let Arrowhead {
+                ia,
+                ja,
+                va,
+                labels,
+                k,
+            } = arrowhead(&sizes, nb, &mut rng);
             let dim = k.nrows();
             let eig = SymmetricEigen::new(k.clone()).eigenvalues;
             assert!(eig.iter().all(|l: &f64| l.abs() > 1e-6), "draw is singular");
@@ -813,7 +829,13 @@ mod tests {
     #[test]
     fn a_pattern_coupling_two_blocks_goes_to_feral() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let (mut ia, mut ja, mut va, labels, mut k) = arrowhead(&[6, 6, 6], 5, &mut rng);
+        let Arrowhead {
+            mut ia,
+            mut ja,
+            mut va,
+            labels,
+            mut k,
+        } = arrowhead(&[6, 6, 6], 5, &mut rng);
         let i = labels.iter().position(|&l| l == 0).unwrap();
         let j = labels.iter().position(|&l| l == 2).unwrap();
         ia.push(i.max(j) as Index + 1);
