@@ -8,12 +8,14 @@
 //! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`,
 //! `PROBE_NLP="name=value;name=value"` (extra solver options; `PROBE_RANK_NLP` and
 //! `PROBE_FINAL_NLP` for the ranking or the working-mesh solves only); `PROBE_FIRST_SEED` (1);
+//! `PROBE_KKT=feral|structured` (the KKT linear solver of every NLP solve);
 //! `PROBE_OUT=DIR` writes
 //! each plan's `plan.json` / `plan.csv` into `DIR/NAME-SEED/` for the judge.
 
 use std::time::Duration;
 
 use wingman_planner::clock::{Deadline, MonotonicClock};
+use wingman_planner::collocation::KktSolver;
 use wingman_planner::hybrid::{Planner, PlannerSettings};
 use wingman_planner::problem::Problem;
 use wingman_planner::scenario::{BUNDLED, bundled};
@@ -70,6 +72,15 @@ fn main() {
     }
     if let Some(v) = env("PROBE_WARM_PUSH") {
         s.nlp.warm_start_push = v;
+    }
+    if let Ok(v) = std::env::var("PROBE_KKT") {
+        let kkt = match v.as_str() {
+            "feral" => KktSolver::Feral,
+            "structured" => KktSolver::Structured,
+            other => panic!("PROBE_KKT={other}: feral or structured"),
+        };
+        s.nlp.kkt = kkt;
+        s.ranking_nlp.kkt = kkt;
     }
     if let Ok(extra) = std::env::var("PROBE_NLP") {
         for kv in extra.split(';').filter(|kv| !kv.is_empty()) {

@@ -1,7 +1,9 @@
 //! Direct orthogonal collocation at Legendre–Gauss–Radau points (FORMULATION.md §4): the
 //! LGR scheme, the mesh and node layout, and the sparse NLP of the transcription.
 
+pub mod bunch_kaufman;
 pub mod export;
+pub mod kkt;
 pub mod lgr;
 pub mod mesh;
 pub mod refine;
@@ -10,6 +12,7 @@ pub mod transcription;
 pub mod warm;
 
 pub use export::{ExportSettings, export, fly};
+pub use kkt::{KktLabels, KktSolver, StructuredKkt};
 pub use lgr::Lgr;
 pub use mesh::{Layout, Mesh};
 pub use refine::{RefineSettings, interval_errors, refine};

@@ -20,6 +20,7 @@ use pounce_rs::{
     IpoptData, IterStats, NlpInfo, Solution, SparsityRequest, StartingPoint, TNLP,
 };
 
+use super::kkt::{KktLabels, KktSolver, StructuredKkt};
 use super::transcription::Transcription;
 use crate::clock::Deadline;
 
@@ -64,6 +65,12 @@ pub struct NlpSettings {
     /// point is a minimum, and leaves along negative curvature if not. 3-25 ms per solve
     /// on the canonical scenarios.
     pub second_order_check: bool,
+    /// The linear solver of the KKT systems: FERAL, or block elimination over the mesh
+    /// intervals ([`super::kkt`]; FERAL where the structure does not hold, and for the
+    /// 3-D KKTs, whose border is too large for its dense factorisation to pay). The
+    /// restoration phase keeps FERAL either way. Structured by default: on the canonical
+    /// scenarios (probe, 3 seeds) 2-D plans 13-37 % faster, the same costs.
+    pub kkt: KktSolver,
     /// Initial barrier parameter of a cold start (`None`: the solver's default, 0.1).
     pub mu_init: Option<f64>,
     /// Initial barrier parameter when starting from a previous solution on a refined mesh.
@@ -93,6 +100,7 @@ impl Default for NlpSettings {
             feral_static_pivoting: false,
             feral_pivtol: None,
             second_order_check: true,
+            kkt: KktSolver::Structured,
             mu_init: None,
             refine_mu_init: 1e-3,
             extra: Vec::new(),
@@ -342,6 +350,7 @@ fn application(
     settings: &NlpSettings,
     warm: bool,
     budget: Duration,
+    labels: Option<KktLabels>,
 ) -> Result<IpoptApplication, OptionError> {
     let mut app = IpoptApplication::new();
     let _ = app.initialize();
@@ -444,7 +453,34 @@ fn application(
         }
     }
     install_restoration(&mut app);
+    if settings.kkt == KktSolver::Structured {
+        install_structured_kkt(&mut app, labels);
+    }
     Ok(app)
+}
+
+/// Plugs the structured KKT backend into `app`'s main algorithm, falling back to FERAL
+/// configured exactly as pounce's default backend would be (the same options). Call after
+/// setting options.
+fn install_structured_kkt(app: &mut IpoptApplication, labels: Option<KktLabels>) {
+    use pounce_feral::FeralSolverInterface;
+    use pounce_linsol::SparseSymLinearSolverInterface;
+    use pounce_rs::pounce_algorithm::alg_builder::LinearSolverChoice;
+    use pounce_rs::pounce_algorithm::application::feral_config_from_options;
+    let feral_cfg = feral_config_from_options(app.options());
+    app.set_linear_backend_factory(Box::new(
+        move |choice| -> Box<dyn SparseSymLinearSolverInterface> {
+            match choice {
+                LinearSolverChoice::Feral => {
+                    Box::new(StructuredKkt::new(labels.clone(), feral_cfg.clone()))
+                }
+                // Not asked for by these settings; pounce's own answer without MA57.
+                LinearSolverChoice::Ma57 => {
+                    Box::new(FeralSolverInterface::with_config(feral_cfg.clone()))
+                }
+            }
+        },
+    ));
 }
 
 /// Solves `tr` from the scaled start `start` (with its duals when `warm_start`), stopping
@@ -459,7 +495,8 @@ pub fn solve(
     let clock = deadline.clock();
     let began = clock.now();
     let n = tr.n_vars();
-    let mut app = application(settings, warm_start, deadline.remaining())?;
+    let labels = (settings.kkt == KktSolver::Structured).then(|| KktLabels::of(&tr));
+    let mut app = application(settings, warm_start, deadline.remaining(), labels)?;
     let adapter = Rc::new(RefCell::new(Adapter {
         tr,
         start,
