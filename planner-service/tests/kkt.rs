@@ -4,15 +4,13 @@
 
 use std::time::Duration;
 
-use wingman_planner::clock::{Deadline, MonotonicClock};
+use wingman_planner::clock::Deadline;
 use wingman_planner::collocation::kkt::block_factorizations_total;
 use wingman_planner::collocation::{
     KktLabels, KktSolver, Mesh, NlpSettings, NlpStatus, PrimalDual, StructuredKkt, Transcription,
     TranscriptionSettings, solve,
 };
-use wingman_planner::hybrid::{Planner, PlannerSettings, phase_durations};
-use wingman_planner::problem::Problem;
-use wingman_planner::scenario::bundled;
+use wingman_planner::hybrid::phase_durations;
 
 use pounce_linsol::{ESymSolverStatus, SparseSymLinearSolverInterface};
 
@@ -20,25 +18,16 @@ use pounce_linsol::{ESymSolverStatus, SparseSymLinearSolverInterface};
 mod counting_alloc;
 use counting_alloc::allocations_in;
 
-fn clock() -> &'static MonotonicClock {
-    Box::leak(Box::new(MonotonicClock::new()))
-}
+#[path = "support/planned.rs"]
+mod planned;
+use planned::{clock, planned};
 
 /// Cold solves of `name` on a 5-point mesh from the hybrid planner's plan, with FERAL and
 /// with the structured backend: both converge, to the same objective within 1e-5 of it
 /// (the solves take different pivots, so their iterates differ by rounding, and both stop
 /// at `tol` 1e-7 on the scaled problem), and the structured one used block elimination.
 fn same_objective(name: &str) {
-    let p = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
-    let settings = PlannerSettings::default();
-    let plan = Planner::new(&settings)
-        .plan(
-            &p,
-            &settings,
-            Deadline::after(clock(), Duration::from_secs(60)),
-        )
-        .unwrap();
-    let guess = plan.trajectory;
+    let (p, guess) = planned(name);
     let mesh = Mesh::uniform(5, &phase_durations(p.t0, &guess), 35.0, 2);
     let mut objective = [0.0; 2];
     for (slot, kkt) in [KktSolver::Feral, KktSolver::Structured]
@@ -104,27 +93,9 @@ fn structured_solve_reaches_ferals_objective_2d_fixed_time() {
 /// (two right-hand sides) allocates nothing.
 #[test]
 fn factorise_and_solve_do_not_allocate() {
-    let p = Problem::from_scenario(
-        &bundled("2d-min-time-rendezvous-avoidable")
-            .unwrap()
-            .unwrap(),
-    )
-    .unwrap();
-    let settings = PlannerSettings::default();
-    let plan = Planner::new(&settings)
-        .plan(
-            &p,
-            &settings,
-            Deadline::after(clock(), Duration::from_secs(60)),
-        )
-        .unwrap();
-    let mesh = Mesh::uniform(5, &phase_durations(p.t0, &plan.trajectory), 35.0, 2);
-    let tr = Transcription::new(
-        &p,
-        &mesh,
-        &plan.trajectory,
-        &TranscriptionSettings::default(),
-    );
+    let (p, guess) = planned("2d-min-time-rendezvous-avoidable");
+    let mesh = Mesh::uniform(5, &phase_durations(p.t0, &guess), 35.0, 2);
+    let tr = Transcription::new(&p, &mesh, &guess, &TranscriptionSettings::default());
     // KKT positions, as pounce numbers them.
     let fixed = |i: usize| tr.x_lo[i] == tr.x_hi[i];
     let mut xpos = vec![usize::MAX; tr.n_vars()];

@@ -5,34 +5,24 @@
 
 use std::time::Duration;
 
-use wingman_planner::clock::{Deadline, MonotonicClock};
+use wingman_planner::clock::Deadline;
 use wingman_planner::collocation::warm::transfer;
 use wingman_planner::collocation::{
     ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, Transcription, TranscriptionSettings,
     export, solve, transcription::INF,
 };
-use wingman_planner::hybrid::{Planner, PlannerSettings, phase_durations};
+use wingman_planner::hybrid::phase_durations;
 use wingman_planner::problem::Problem;
-use wingman_planner::scenario::bundled;
 use wingman_planner::trajectory::Trajectory;
 
-fn clock() -> &'static MonotonicClock {
-    Box::leak(Box::new(MonotonicClock::new()))
-}
+#[path = "support/planned.rs"]
+mod planned;
+use planned::{clock, planned};
 
 /// A converged solve of `name` on a uniform mesh of `points` per `interval_s`, started
 /// from the hybrid planner's own plan (a good guess in the right basin).
 fn converged(name: &str, points: usize, interval_s: f64) -> (Problem, Transcription, PrimalDual) {
-    let p = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
-    let settings = PlannerSettings::default();
-    let plan = Planner::new(&settings)
-        .plan(
-            &p,
-            &settings,
-            Deadline::after(clock(), Duration::from_secs(60)),
-        )
-        .unwrap();
-    let guess = plan.trajectory;
+    let (p, guess) = planned(name);
     let mesh = Mesh::uniform(points, &phase_durations(p.t0, &guess), interval_s, 2);
     let (tr, sol) = solve_from(&p, &mesh, &guess, None);
     (p, tr, sol.expect("the reference solve converges"))
