@@ -199,4 +199,9 @@ fn main() {
         );
     }
     println!("worst cost/ref {worst:.5}");
+    println!(
+        "KKT factorisations: {} by block elimination, {} handed to FERAL",
+        wingman_planner::collocation::kkt::block_factorizations_total(),
+        wingman_planner::collocation::kkt::feral_fallbacks_total()
+    );
 }

@@ -87,15 +87,28 @@ fn structured_solve_reaches_ferals_objective_2d_fixed_time() {
     same_objective("2d-fixed-time-unavoidable");
 }
 
-/// The labels of a real transcription, on a KKT pattern assembled as pounce assembles it
-/// (`[x not fixed | slacks | equality duals | inequality duals]`, Hessian and Jacobian
-/// entries, every diagonal), are accepted; then factorising and solving again and again
-/// (two right-hand sides) allocates nothing.
 #[test]
-fn factorise_and_solve_do_not_allocate() {
-    let (p, guess) = planned("2d-min-time-rendezvous-avoidable");
+fn structured_solve_reaches_ferals_objective_3d_rendezvous() {
+    same_objective("3d-min-time-rendezvous-avoidable");
+}
+
+/// The labels of a real transcription of `name`, on a KKT pattern assembled as pounce
+/// assembles it (`[x not fixed | slacks | equality duals | inequality duals]`, Hessian
+/// and Jacobian entries, every diagonal), are accepted, with a border of at most
+/// `3 · phases + 3` indices (the phase times, the phase-order rows' slacks and duals, the
+/// rendezvous rows); then factorising and solving again and again (two right-hand sides)
+/// allocates nothing.
+fn labels_fit_and_do_not_allocate(name: &str) {
+    let (p, guess) = planned(name);
     let mesh = Mesh::uniform(5, &phase_durations(p.t0, &guess), 35.0, 2);
     let tr = Transcription::new(&p, &mesh, &guess, &TranscriptionSettings::default());
+    let labels = KktLabels::of(&tr);
+    let border = labels.0.iter().filter(|&&l| l < 0).count();
+    let phases = mesh.phases.len();
+    assert!(
+        border <= 3 * phases + 3,
+        "{name}: border of {border} with {phases} phases"
+    );
     // KKT positions, as pounce numbers them.
     let fixed = |i: usize| tr.x_lo[i] == tr.x_hi[i];
     let mut xpos = vec![usize::MAX; tr.n_vars()];
@@ -153,7 +166,7 @@ fn factorise_and_solve_do_not_allocate() {
     for (k, r) in (0..tr.n_cons()).filter(|&r| !eq(r)).enumerate() {
         push(dpos[r], n + k, -1.0);
     }
-    let mut solver = StructuredKkt::new(Some(KktLabels::of(&tr)), Default::default());
+    let mut solver = StructuredKkt::new(Some(labels), Default::default());
     let nnz = ia.len() as i32;
     assert_eq!(
         solver.initialize_structure(dim as i32, nnz, &ia, &ja),
@@ -179,4 +192,14 @@ fn factorise_and_solve_do_not_allocate() {
     });
     assert_eq!(allocations, 0);
     assert_eq!(solver.feral_factorizations, 0);
+}
+
+#[test]
+fn factorise_and_solve_do_not_allocate_2d() {
+    labels_fit_and_do_not_allocate("2d-min-time-rendezvous-avoidable");
+}
+
+#[test]
+fn factorise_and_solve_do_not_allocate_3d() {
+    labels_fit_and_do_not_allocate("3d-min-time-rendezvous-unavoidable");
 }

@@ -3,26 +3,32 @@
 //! factorisations ([`super::bunch_kaufman`]), in place of the general sparse
 //! factorisation (FERAL).
 //!
-//! The KKT indices are split into one block per mesh interval (that interval's interior
-//! state points, its controls and its defect multipliers) and a border (the
-//! interval-boundary state points shared by neighbouring intervals, the phase end times,
-//! the phase-order rows with their slacks, the rendezvous rows): blocks couple to the
-//! border only, never to each other. Per factorisation
+//! The KKT indices are split into one block per mesh interval (that interval's states
+//! after its first point — so its end point, the next interval's first — its controls and
+//! its defect multipliers) and a small border (the phase end times, the phase-order rows
+//! with their slacks, the rendezvous rows). Block `k` couples only to the border and to
+//! block `k - 1` (its defects read the previous interval's end point): a block-tridiagonal
+//! matrix with a border. Per factorisation, in block order (`Ã_00 = A_00`, `W̃_0 = W_0`),
 //!
 //! ```text
-//!   A_kk = P L D Lᵀ Pᵀ          (dense Bunch–Kaufman, per block)
-//!   Y_k  = A_kk⁻¹ A_kb           (its border columns)
-//!   S    = A_bb − Σ_k A_bk Y_k   (dense border Schur complement, factored the same way)
-//!   inertia(K) = Σ_k inertia(A_kk) + inertia(S)   (Haynsworth)
+//!   Ã_kk = P L D Lᵀ Pᵀ                       (dense Bunch–Kaufman, per block)
+//!   Y_k  = Ã_kk⁻¹ W̃_k                         (its border columns)
+//!   S   -= W̃_kᵀ Y_k                           (dense border Schur complement)
+//!   Ã_k+1 = A_k+1 − C_k+1 Ã_kk⁻¹ C_k+1ᵀ       (C: block k+1's rows, block k's columns)
+//!   W̃_k+1 = W_k+1 − C_k+1 Y_k
+//!   inertia(K) = Σ_k inertia(Ã_kk) + inertia(S)   (Haynsworth)
 //! ```
 //!
-//! and a solve is block elimination (`S Δ_b = b_b − Σ Y_kᵀ b_k`,
-//! `x_k = A_kk⁻¹ b_k − Y_k Δ_b`). Nothing allocates after
-//! [`SparseSymLinearSolverInterface::initialize_structure`].
+//! where `C_k+1` touches only the few columns of block `k`'s end point, so the chain
+//! terms are small. A solve runs forward through the blocks, solves the border, and runs
+//! back. Nothing allocates after
+//! [`SparseSymLinearSolverInterface::initialize_structure`]. A partition without chain
+//! couplings (every `C` empty) is the plain arrowhead.
 //!
 //! **Never a silent mislabel.** The labels come from the [`Transcription`] (see
 //! [`KktLabels::of`]) and are checked against the assembled pattern: a dimension that
-//! differs, or any entry coupling two blocks, sends every factorisation of that matrix to
+//! differs, or any entry coupling two blocks that are not neighbours, sends every
+//! factorisation of that matrix to
 //! an inner [`FeralSolverInterface`] built with the configuration pounce's default backend
 //! would use, so the solve behaves as it does without this module. Block elimination is
 //! exact for any partition that passes the check; the labels only decide its speed.
@@ -66,18 +72,29 @@ const POUNCE_INF: f64 = 1e19;
 const MAX_BLOCK: usize = 600;
 
 /// Largest border the dense path takes: the dense border factorisation grows as its
-/// cube. Measured on the canonical scenarios (probe, 3 seeds): 2-D borders (74-152) plan
-/// 13-37 % faster than with FERAL; 3-D borders (200-430) plan no faster, up to 1.7 times
-/// slower on the largest, so 3-D KKTs stay with FERAL.
+/// cube. With the interval ends in the blocks the collocation's borders hold only the
+/// phase times and the phase-order and rendezvous rows (at most `3 · phases + 3` indices,
+/// `tests/kkt.rs`); when the interval
+/// ends were in the border (74-152 in 2-D, 200-430 in 3-D), the 3-D ones planned no
+/// faster than FERAL.
 const MAX_BORDER: usize = 160;
 
 /// Factorisations done by block elimination, over the process (diagnostics and tests).
 static BLOCK_FACTORIZATIONS: std::sync::atomic::AtomicUsize =
     std::sync::atomic::AtomicUsize::new(0);
 
+/// Factorisations of labelled matrices that block elimination handed to FERAL (a pivot
+/// under the floor, a non-finite entry), over the process.
+static FERAL_FALLBACKS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
 /// How many KKT factorisations block elimination has done in this process.
 pub fn block_factorizations_total() -> usize {
     BLOCK_FACTORIZATIONS.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// How many factorisations of matrices the labels fit went to FERAL in this process.
+pub fn feral_fallbacks_total() -> usize {
+    FERAL_FALLBACKS.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 /// Most refinement steps per solve, and the backward error that stops them.
@@ -101,14 +118,23 @@ impl KktLabels {
         let mut var = vec![-1i32; tr.n_vars()];
         for (k, node) in tr.layout.nodes.iter().enumerate() {
             let interval = (k / n_pts) as i32;
-            if node.local != 0 {
-                for c in 0..nx {
-                    var[tr.state(k, c)] = interval;
-                }
+            // An interval's first point ends the previous interval (node 0 has none).
+            let owner = if node.local == 0 {
+                (interval - 1).max(0)
+            } else {
+                interval
+            };
+            for c in 0..nx {
+                var[tr.state(k, c)] = owner;
             }
             for e in 0..nu {
                 var[tr.control(k, e)] = interval;
             }
+        }
+        // The final node ends the last interval.
+        let last = tr.layout.nodes.len();
+        for c in 0..nx {
+            var[tr.state(last, c)] = (last / n_pts) as i32 - 1;
         }
         let mut con = vec![-1i32; tr.n_cons()];
         for k in 0..n_ctrl {
@@ -136,20 +162,28 @@ impl KktLabels {
 }
 
 /// One block's place in the workspace.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct Block {
     /// Order of `A_kk`.
     n: usize,
     /// Its KKT indices are `members[first..first + n]` (also its offset in `work`/`piv`).
     first: usize,
-    /// Border columns it touches: `border_cols[b_first..b_first + m]` (border-local,
-    /// increasing).
+    /// Offset of `A_kk` (`n × n`) in `dense`.
+    a_off: usize,
+    /// Border columns of `W_k` (the original ones and the fill from the previous block):
+    /// `border_cols[b_first..b_first + m]` (border-local, increasing); `W_k` (`n × m`) at
+    /// `w_off` in the `W` part of `dense`, `Y_k = Ã_kk⁻¹ W_k` at `y_off` in `y`.
     m: usize,
     b_first: usize,
-    /// Offsets of `A_kk` (`n × n`) and of `A_kb` (`n × m`) in `dense`, and of `Y_k` in `y`.
-    a_off: usize,
-    c_off: usize,
+    w_off: usize,
     y_off: usize,
+    /// Link to the previous block: its local indices `links[l_first..l_first + l]`
+    /// (increasing) that this block touches; `C_k` (`n × l`, this block's rows, those
+    /// columns) at `c_off` in the `C` part of `dense`, `Z_k = Ã_{k-1}⁻¹ E_L` (`n_{k-1} × l`) at `z_off` in `z`.
+    l: usize,
+    l_first: usize,
+    c_off: usize,
+    z_off: usize,
 }
 
 /// Every buffer of the structured path, sized in `initialize_structure`.
@@ -160,17 +194,28 @@ struct Workspace {
     blocks: Vec<Block>,
     members: Vec<usize>,
     border_cols: Vec<usize>,
+    links: Vec<usize>,
+    /// Position in the previous block's `border_cols` of each of a block's border columns
+    /// (`usize::MAX`: not there), aligned with `border_cols`.
+    prev_col: Vec<usize>,
     /// KKT index of each border position.
     border: Vec<usize>,
-    /// All `A_kk`, then all `A_kb`, then `S` (`nb × nb`), column-major.
+    /// All `A_kk`, then all `C_k`, then all `W_k`, then `S` (`nb × nb`), column-major.
     dense: Vec<f64>,
+    c_base: usize,
+    w_base: usize,
     s_off: usize,
     y: Vec<f64>,
+    z: Vec<f64>,
     /// Pivots: the blocks' at their `first`, `S`'s after them.
     piv: Vec<i32>,
-    /// Solve scratch: block parts and border part of one right-hand side.
+    /// Factorisation scratch: `M = Z[L, :]` (`l × l`) and `C M` (`n × l`).
+    m_link: Vec<f64>,
+    cm: Vec<f64>,
+    /// Solve scratch: block parts and border part of one right-hand side, and `Cᵀ x`.
     work: Vec<f64>,
     work_b: Vec<f64>,
+    ctx: Vec<f64>,
     /// The pattern (0-based) and the largest entry magnitude, for residuals.
     rows: Vec<u32>,
     cols: Vec<u32>,
@@ -182,42 +227,51 @@ struct Workspace {
 
 impl Workspace {
     /// The workspace for the pattern `(ia, ja)` (1-based) under `labels`, or `None` when
-    /// the labels do not describe it.
+    /// the labels do not describe it (an entry coupling two blocks that are not
+    /// neighbours in label order, a block or border too large).
     fn new(dim: usize, ia: &[Index], ja: &[Index], labels: &[i32]) -> Option<Workspace> {
         if labels.len() != dim || ia.len() != ja.len() {
             return None;
         }
-        // Compact block ids in order of first appearance.
         let max = labels.iter().copied().max().unwrap_or(-1);
         if max < 0 {
             return None;
         }
-        let mut remap = vec![usize::MAX; max as usize + 1];
+        // Compact block ids, keeping the label order (the chain's order).
+        let mut present = vec![false; max as usize + 1];
+        for &l in labels.iter().filter(|&&l| l >= 0) {
+            present[l as usize] = true;
+        }
+        let mut remap = vec![usize::MAX; present.len()];
+        let mut count = 0;
+        for (slot, &p) in remap.iter_mut().zip(&present) {
+            if p {
+                *slot = count;
+                count += 1;
+            }
+        }
         let mut block_of = vec![usize::MAX; dim];
         let mut local = vec![0usize; dim];
-        let mut sizes: Vec<usize> = Vec::new();
+        let mut sizes = vec![0usize; count];
         let mut border = Vec::new();
         for (i, &l) in labels.iter().enumerate() {
             if l < 0 {
                 local[i] = border.len();
                 border.push(i);
             } else {
-                let slot = &mut remap[l as usize];
-                if *slot == usize::MAX {
-                    *slot = sizes.len();
-                    sizes.push(0);
-                }
-                block_of[i] = *slot;
-                local[i] = sizes[*slot];
-                sizes[*slot] += 1;
+                let b = remap[l as usize];
+                block_of[i] = b;
+                local[i] = sizes[b];
+                sizes[b] += 1;
             }
         }
         let nb = border.len();
-        if sizes.is_empty() || nb > MAX_BORDER || sizes.iter().any(|&s| s > MAX_BLOCK) {
+        if nb > MAX_BORDER || sizes.iter().any(|&s| s > MAX_BLOCK) {
             return None;
         }
-        // Border columns per block, from the pattern; any block-block coupling refuses.
-        let mut touches: Vec<Vec<usize>> = vec![Vec::new(); sizes.len()];
+        // Border columns and links per block, from the pattern.
+        let mut touches: Vec<Vec<usize>> = vec![Vec::new(); count];
+        let mut linked: Vec<Vec<usize>> = vec![Vec::new(); count];
         for (&r, &c) in ia.iter().zip(ja) {
             let (r, c) = (r as usize, c as usize);
             if r == 0 || c == 0 || r > dim || c > dim {
@@ -228,37 +282,66 @@ impl Workspace {
                 (usize::MAX, usize::MAX) => {}
                 (usize::MAX, b) => touches[b].push(local[r]),
                 (b, usize::MAX) => touches[b].push(local[c]),
+                (br, bc) if br == bc + 1 => linked[br].push(local[c]),
+                (br, bc) if bc == br + 1 => linked[bc].push(local[r]),
                 (br, bc) if br != bc => return None,
                 _ => {}
             }
+        }
+        // A block linked to its predecessor inherits its border columns (fill).
+        for b in 0..count {
+            linked[b].sort_unstable();
+            linked[b].dedup();
+            if b > 0 && !linked[b].is_empty() {
+                let inherited = touches[b - 1].clone();
+                touches[b].extend(inherited);
+            }
+            touches[b].sort_unstable();
+            touches[b].dedup();
         }
         let mut ws = Workspace {
             border,
             ..Workspace::default()
         };
-        let mut first = 0;
-        let (mut a_len, mut c_len) = (0, 0);
-        for (b, t) in touches.iter_mut().enumerate() {
-            t.sort_unstable();
-            t.dedup();
-            let n = sizes[b];
+        let (mut first, mut a_len, mut c_len, mut w_len, mut z_len) = (0, 0, 0, 0, 0);
+        let (mut max_l, mut max_nl) = (0, 0);
+        for b in 0..count {
+            let (n, m, l) = (sizes[b], touches[b].len(), linked[b].len());
             ws.blocks.push(Block {
                 n,
                 first,
-                m: t.len(),
-                b_first: ws.border_cols.len(),
                 a_off: a_len,
-                c_off: 0,
-                y_off: c_len,
+                m,
+                b_first: ws.border_cols.len(),
+                w_off: w_len,
+                y_off: w_len,
+                l,
+                l_first: ws.links.len(),
+                c_off: c_len,
+                z_off: z_len,
             });
-            ws.border_cols.extend_from_slice(t);
+            for &col in &touches[b] {
+                let prev = if b > 0 && l > 0 {
+                    touches[b - 1].binary_search(&col).unwrap_or(usize::MAX)
+                } else {
+                    usize::MAX
+                };
+                ws.prev_col.push(prev);
+            }
+            ws.border_cols.extend_from_slice(&touches[b]);
+            ws.links.extend_from_slice(&linked[b]);
             first += n;
             a_len += n * n;
-            c_len += n * t.len();
+            c_len += n * l;
+            w_len += n * m;
+            if l > 0 {
+                z_len += sizes[b - 1] * l;
+            }
+            max_l = max_l.max(l);
+            max_nl = max_nl.max(n * l);
         }
-        for blk in &mut ws.blocks {
-            blk.c_off = a_len + blk.y_off;
-        }
+        ws.c_base = a_len;
+        ws.w_base = a_len + c_len;
         ws.members = vec![0; first];
         let mut fill: Vec<usize> = ws.blocks.iter().map(|b| b.first).collect();
         for (i, &b) in block_of.iter().enumerate() {
@@ -267,17 +350,21 @@ impl Workspace {
                 fill[b] += 1;
             }
         }
-        ws.s_off = a_len + c_len;
-        ws.dense = vec![0.0; a_len + c_len + nb * nb];
-        ws.y = vec![0.0; c_len];
+        ws.s_off = a_len + c_len + w_len;
+        ws.dense = vec![0.0; ws.s_off + nb * nb];
+        ws.y = vec![0.0; w_len];
+        ws.z = vec![0.0; z_len];
         ws.piv = vec![0; first + nb];
+        ws.m_link = vec![0.0; max_l * max_l];
+        ws.cm = vec![0.0; max_nl];
         ws.work = vec![0.0; first];
         ws.work_b = vec![0.0; nb];
+        ws.ctx = vec![0.0; max_l];
         ws.rhs = vec![0.0; dim];
         ws.res = vec![0.0; dim];
         ws.rows = ia.iter().map(|&r| (r - 1) as u32).collect();
         ws.cols = ja.iter().map(|&c| (c - 1) as u32).collect();
-        // Where each nonzero goes (lower triangle of each dense matrix).
+        // Where each nonzero goes (lower triangle of each symmetric dense matrix).
         ws.dest = Vec::with_capacity(ia.len());
         for (&r, &c) in ia.iter().zip(ja) {
             let (r, c) = (r as usize - 1, c as usize - 1);
@@ -295,7 +382,18 @@ impl Workspace {
                     let blk = ws.blocks[b];
                     let cols = &ws.border_cols[blk.b_first..blk.b_first + blk.m];
                     let j = cols.binary_search(&bcol).ok()?;
-                    blk.c_off + row + j * blk.n
+                    ws.w_base + blk.w_off + row + j * blk.n
+                }
+                (br, bc) if br != bc => {
+                    let (hi, row, prev) = if br > bc {
+                        (br, local[r], local[c])
+                    } else {
+                        (bc, local[c], local[r])
+                    };
+                    let blk = ws.blocks[hi];
+                    let links = &ws.links[blk.l_first..blk.l_first + blk.l];
+                    let j = links.binary_search(&prev).ok()?;
+                    ws.c_base + blk.c_off + row + j * blk.n
                 }
                 (b, _) => {
                     let blk = ws.blocks[b];
@@ -318,32 +416,105 @@ impl Workspace {
             self.k_max = self.k_max.max(v.abs());
         }
         let nb = self.border.len();
-        let (blocks_part, s) = self.dense.split_at_mut(self.s_off);
+        let (a_all, rest) = self.dense.split_at_mut(self.c_base);
+        let (c_all, rest) = rest.split_at_mut(self.w_base - self.c_base);
+        let (w_all, s) = rest.split_at_mut(self.s_off - self.w_base);
         let mut negative = 0;
-        for blk in &self.blocks {
-            let (n, m) = (blk.n, blk.m);
-            let (a_all, c_all) = blocks_part.split_at_mut(blk.c_off);
-            let a = &mut a_all[blk.a_off..blk.a_off + n * n];
+        for k in 0..self.blocks.len() {
+            let blk = self.blocks[k];
+            let next = self.blocks.get(k + 1).copied().unwrap_or_default();
+            let (n, m, nn) = (blk.n, blk.m, next.n);
+            // Ã_kk (already updated by the previous block) and Ã_{k+1}; W_k and W_{k+1}.
+            let (a_lo, a_hi) = a_all.split_at_mut(blk.a_off + n * n);
+            let a = &mut a_lo[blk.a_off..];
+            let (w_lo, w_hi) = w_all.split_at_mut(blk.w_off + n * m);
+            let w = &w_lo[blk.w_off..];
             let piv = &mut self.piv[blk.first..blk.first + n];
             let inertia = bunch_kaufman::factor(a, n, piv)?;
             if inertia.min_pivot < floor {
                 return None;
             }
             negative += inertia.negative;
-            let c = &c_all[..n * m];
+            let (a, piv) = (&*a, &*piv);
+            // Y_k = Ã_kk⁻¹ W_k.
             let y = &mut self.y[blk.y_off..blk.y_off + n * m];
-            y.copy_from_slice(c);
+            y.copy_from_slice(w);
             for col in y.chunks_exact_mut(n) {
                 bunch_kaufman::solve(a, n, piv, col);
             }
-            // S -= A_bk Y_k over the lower triangle (border columns increase).
+            let y = &*y;
+            // S -= W_kᵀ Y_k over the lower triangle (border columns increase).
             let cols = &self.border_cols[blk.b_first..blk.b_first + m];
             for (jj, &bj) in cols.iter().enumerate() {
                 let yj = &y[jj * n..(jj + 1) * n];
                 for (ii, &bi) in cols.iter().enumerate().skip(jj) {
-                    let ci = &c[ii * n..(ii + 1) * n];
-                    let dot: f64 = ci.iter().zip(yj).map(|(p, q)| p * q).sum();
+                    let wi = &w[ii * n..(ii + 1) * n];
+                    let dot: f64 = wi.iter().zip(yj).map(|(p, q)| p * q).sum();
                     s[bi + bj * nb] -= dot;
+                }
+            }
+            // The next block, if linked: Z = Ã_kk⁻¹ E_L, M = Z[L, :],
+            // Ã_{k+1} -= C M Cᵀ and W_{k+1} -= C Y_k[L, :].
+            let l = next.l;
+            if l == 0 {
+                continue;
+            }
+            let links = &self.links[next.l_first..next.l_first + l];
+            let z = &mut self.z[next.z_off..next.z_off + n * l];
+            z.iter_mut().for_each(|v| *v = 0.0);
+            for (col, &li) in z.chunks_exact_mut(n).zip(links) {
+                col[li] = 1.0;
+                bunch_kaufman::solve(a, n, piv, col);
+            }
+            let mm = &mut self.m_link[..l * l];
+            for (j, col) in z.chunks_exact(n).enumerate() {
+                for (i, &li) in links.iter().enumerate() {
+                    mm[i + j * l] = col[li];
+                }
+            }
+            let c = &c_all[next.c_off..next.c_off + nn * l];
+            let cm = &mut self.cm[..nn * l];
+            cm.iter_mut().for_each(|v| *v = 0.0);
+            for j in 0..l {
+                let out = &mut cm[j * nn..(j + 1) * nn];
+                for q in 0..l {
+                    let f = mm[q + j * l];
+                    if f != 0.0 {
+                        for (o, &cv) in out.iter_mut().zip(&c[q * nn..(q + 1) * nn]) {
+                            *o += cv * f;
+                        }
+                    }
+                }
+            }
+            // Lower triangle of Ã_{k+1} -= (C M) Cᵀ.
+            let a_next = &mut a_hi[next.a_off - blk.a_off - n * n..][..nn * nn];
+            for q in 0..l {
+                let cmq = &cm[q * nn..(q + 1) * nn];
+                let cq = &c[q * nn..(q + 1) * nn];
+                for (j, &f) in cq.iter().enumerate() {
+                    if f != 0.0 {
+                        let col = &mut a_next[j * nn + j..(j + 1) * nn];
+                        for (av, &v) in col.iter_mut().zip(&cmq[j..]) {
+                            *av -= v * f;
+                        }
+                    }
+                }
+            }
+            let w_next = &mut w_hi[next.w_off - blk.w_off - n * m..][..nn * next.m];
+            let prev = &self.prev_col[next.b_first..next.b_first + next.m];
+            for (jj, &pj) in prev.iter().enumerate() {
+                if pj == usize::MAX {
+                    continue;
+                }
+                let yj = &y[pj * n..(pj + 1) * n];
+                let out = &mut w_next[jj * nn..(jj + 1) * nn];
+                for (q, &li) in links.iter().enumerate() {
+                    let f = yj[li];
+                    if f != 0.0 {
+                        for (o, &cv) in out.iter_mut().zip(&c[q * nn..(q + 1) * nn]) {
+                            *o -= cv * f;
+                        }
+                    }
                 }
             }
         }
@@ -393,15 +564,33 @@ impl Workspace {
     /// Solves in place for one right-hand side `b` (KKT order), without refinement.
     fn solve(&mut self, b: &mut [f64]) {
         let nb = self.border.len();
+        let c_all = &self.dense[self.c_base..self.w_base];
         let s = &self.dense[self.s_off..];
         for (w, &i) in self.work_b.iter_mut().zip(&self.border) {
             *w = b[i];
         }
-        for blk in &self.blocks {
-            let (n, m) = (blk.n, blk.m);
-            let t = &mut self.work[blk.first..blk.first + n];
+        // Forward: t_k = b_k - C_k u_{k-1}[L_k], u_k = Ã_kk⁻¹ t_k, b_G -= Y_kᵀ t_k.
+        for k in 0..self.blocks.len() {
+            let blk = self.blocks[k];
+            let (n, m, l) = (blk.n, blk.m, blk.l);
+            let (done, now) = self.work.split_at_mut(blk.first);
+            let t = &mut now[..n];
             for (ti, &i) in t.iter_mut().zip(&self.members[blk.first..blk.first + n]) {
                 *ti = b[i];
+            }
+            if l > 0 {
+                let prev = self.blocks[k - 1];
+                let u_prev = &done[prev.first..prev.first + prev.n];
+                let c = &c_all[blk.c_off..blk.c_off + n * l];
+                let links = &self.links[blk.l_first..blk.l_first + l];
+                for (cq, &li) in c.chunks_exact(n).zip(links) {
+                    let f = u_prev[li];
+                    if f != 0.0 {
+                        for (ti, &cv) in t.iter_mut().zip(cq) {
+                            *ti -= cv * f;
+                        }
+                    }
+                }
             }
             let y = &self.y[blk.y_off..blk.y_off + n * m];
             let cols = &self.border_cols[blk.b_first..blk.b_first + m];
@@ -415,9 +604,12 @@ impl Workspace {
         if nb > 0 {
             bunch_kaufman::solve(s, nb, &self.piv[self.members.len()..], &mut self.work_b);
         }
-        for blk in &self.blocks {
+        // Backward: x_k = u_k - Y_k x_G - Z_{k+1} (C_{k+1}ᵀ x_{k+1}).
+        for k in (0..self.blocks.len()).rev() {
+            let blk = self.blocks[k];
             let (n, m) = (blk.n, blk.m);
-            let t = &mut self.work[blk.first..blk.first + n];
+            let (now, later) = self.work.split_at_mut(blk.first + n);
+            let t = &mut now[blk.first..];
             let y = &self.y[blk.y_off..blk.y_off + n * m];
             let cols = &self.border_cols[blk.b_first..blk.b_first + m];
             for (yj, &bj) in y.chunks_exact(n).zip(cols) {
@@ -425,6 +617,25 @@ impl Workspace {
                 if v != 0.0 {
                     for (ti, &yv) in t.iter_mut().zip(yj) {
                         *ti -= yv * v;
+                    }
+                }
+            }
+            if let Some(&next) = self.blocks.get(k + 1) {
+                let (nn, l) = (next.n, next.l);
+                if l > 0 {
+                    let x_next = &later[..nn];
+                    let c = &c_all[next.c_off..next.c_off + nn * l];
+                    let ctx = &mut self.ctx[..l];
+                    for (o, cq) in ctx.iter_mut().zip(c.chunks_exact(nn)) {
+                        *o = cq.iter().zip(x_next).map(|(p, q)| p * q).sum();
+                    }
+                    let z = &self.z[next.z_off..next.z_off + n * l];
+                    for (zq, &f) in z.chunks_exact(n).zip(ctx.iter()) {
+                        if f != 0.0 {
+                            for (ti, &zv) in t.iter_mut().zip(zq) {
+                                *ti -= zv * f;
+                            }
+                        }
                     }
                 }
             }
@@ -572,6 +783,7 @@ impl SparseSymLinearSolverInterface for StructuredKkt {
                 None
             };
             let Some(neg) = neg else {
+                FERAL_FALLBACKS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 return self.feral_solve(true, ia, ja, nrhs, rhs_vals, check, expected);
             };
             self.block_factorizations += 1;
@@ -675,8 +887,10 @@ mod tests {
     }
 
     /// A random symmetric indefinite arrowhead: blocks of `sizes` (each coupled to a few
-    /// border indices), a border of `nb`, indices shuffled over the KKT.
-    fn arrowhead(sizes: &[usize], nb: usize, rng: &mut ChaCha8Rng) -> Arrowhead {
+    /// border indices), a border of `nb`, indices shuffled over the KKT; with `chain`,
+    /// each block also couples to up to three indices of the block before it (a block
+    /// tridiagonal arrowhead, as the collocation's interval ends make it).
+    fn arrowhead(sizes: &[usize], nb: usize, chain: bool, rng: &mut ChaCha8Rng) -> Arrowhead {
         let dim = sizes.iter().sum::<usize>() + nb;
         let mut order: Vec<usize> = (0..dim).collect();
         for i in (1..dim).rev() {
@@ -715,6 +929,18 @@ mod tests {
                 }
             }
         }
+        if chain {
+            for pair in members.windows(2) {
+                let (prev, this) = (&pair[0], &pair[1]);
+                for &j in prev.iter().take(3) {
+                    for &i in this {
+                        if rng.random_range(0.0..1.0) < 0.5 {
+                            push(i, j, rng.random_range(-1.0..1.0));
+                        }
+                    }
+                }
+            }
+        }
         for (p, &i) in border.iter().enumerate() {
             push(i, i, rng.random_range(-3.0..3.0));
             if p > 0 {
@@ -722,7 +948,9 @@ mod tests {
             }
         }
         // A duplicate entry: the two values add, as pounce's assembly expects.
-        push(border[0], border[0], 0.5);
+        if let Some(&b0) = border.first() {
+            push(b0, b0, 0.5);
+        }
         let mut k = DMatrix::zeros(dim, dim);
         for ((&r, &c), &v) in ia.iter().zip(&ja).zip(&va) {
             let (r, c) = (r as usize - 1, c as usize - 1);
@@ -771,17 +999,23 @@ mod tests {
         )
     }
 
-    /// Block elimination on random arrowheads (indefinite blocks and border, indices
-    /// shuffled, a duplicate entry): three right-hand sides solved as by nalgebra's LU to
-    /// 1e-9 relative, and the inertia equal to the signs of `SymmetricEigen`.
+    /// Block elimination on random arrowheads, plain and chained (indefinite blocks and
+    /// border, indices shuffled, a duplicate entry): three right-hand sides solved as by
+    /// nalgebra's LU to 1e-9 relative, and the inertia equal to the signs of
+    /// `SymmetricEigen`.
     #[test]
     fn arrowhead_matches_a_dense_solve_and_the_eigenvalues() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
-        for (sizes, nb) in [
-            (vec![5, 7, 6], 4),
-            (vec![12; 6], 9),
-            (vec![1, 2, 3], 1),
-            (vec![30, 25], 20),
+        for (sizes, nb, chain) in [
+            (vec![5, 7, 6], 4, false),
+            (vec![12; 6], 9, false),
+            (vec![1, 2, 3], 1, false),
+            (vec![30, 25], 20, false),
+            (vec![5, 7, 6], 4, true),
+            (vec![12; 6], 9, true),
+            (vec![1, 2, 3], 1, true),
+            (vec![30, 25], 20, true),
+            (vec![9; 12], 0, true),
         ] {
             let Arrowhead {
                 ia,
@@ -789,7 +1023,7 @@ mod tests {
                 va,
                 labels,
                 k,
-            } = arrowhead(&sizes, nb, &mut rng);
+            } = arrowhead(&sizes, nb, chain, &mut rng);
             let dim = k.nrows();
             let eig = SymmetricEigen::new(k.clone()).eigenvalues;
             assert!(eig.iter().all(|l: &f64| l.abs() > 1e-6), "draw is singular");
@@ -823,8 +1057,8 @@ mod tests {
         }
     }
 
-    /// An entry coupling two blocks: the labels do not describe the matrix, so FERAL
-    /// factors it, and the solve is still right (1e-9 relative to LU). A label vector of
+    /// An entry coupling two blocks that are not neighbours (blocks 0 and 2 of a chain):
+    /// the labels do not describe the matrix, so FERAL factors it, and the solve is still right (1e-9 relative to LU). A label vector of
     /// the wrong length does the same.
     #[test]
     fn a_pattern_coupling_two_blocks_goes_to_feral() {
@@ -835,7 +1069,7 @@ mod tests {
             mut va,
             labels,
             mut k,
-        } = arrowhead(&[6, 6, 6], 5, &mut rng);
+        } = arrowhead(&[6, 6, 6], 5, true, &mut rng);
         let i = labels.iter().position(|&l| l == 0).unwrap();
         let j = labels.iter().position(|&l| l == 2).unwrap();
         ia.push(i.max(j) as Index + 1);
