@@ -439,9 +439,7 @@ impl Workspace {
             // Y_k = Ã_kk⁻¹ W_k.
             let y = &mut self.y[blk.y_off..blk.y_off + n * m];
             y.copy_from_slice(w);
-            for col in y.chunks_exact_mut(n) {
-                bunch_kaufman::solve(a, n, piv, col);
-            }
+            bunch_kaufman::solve_many(a, n, piv, y, m);
             let y = &*y;
             // S -= W_kᵀ Y_k over the lower triangle (border columns increase).
             let cols = &self.border_cols[blk.b_first..blk.b_first + m];
@@ -449,7 +447,7 @@ impl Workspace {
                 let yj = &y[jj * n..(jj + 1) * n];
                 for (ii, &bi) in cols.iter().enumerate().skip(jj) {
                     let wi = &w[ii * n..(ii + 1) * n];
-                    let dot: f64 = wi.iter().zip(yj).map(|(p, q)| p * q).sum();
+                    let dot = bunch_kaufman::dot(wi, yj);
                     s[bi + bj * nb] -= dot;
                 }
             }
@@ -464,8 +462,8 @@ impl Workspace {
             z.iter_mut().for_each(|v| *v = 0.0);
             for (col, &li) in z.chunks_exact_mut(n).zip(links) {
                 col[li] = 1.0;
-                bunch_kaufman::solve(a, n, piv, col);
             }
+            bunch_kaufman::solve_many(a, n, piv, z, l);
             let mm = &mut self.m_link[..l * l];
             for (j, col) in z.chunks_exact(n).enumerate() {
                 for (i, &li) in links.iter().enumerate() {
@@ -595,7 +593,7 @@ impl Workspace {
             let y = &self.y[blk.y_off..blk.y_off + n * m];
             let cols = &self.border_cols[blk.b_first..blk.b_first + m];
             for (yj, &bj) in y.chunks_exact(n).zip(cols) {
-                let dot: f64 = yj.iter().zip(t.iter()).map(|(p, q)| p * q).sum();
+                let dot = bunch_kaufman::dot(yj, t);
                 self.work_b[bj] -= dot;
             }
             let a = &self.dense[blk.a_off..blk.a_off + n * n];
@@ -627,7 +625,7 @@ impl Workspace {
                     let c = &c_all[next.c_off..next.c_off + nn * l];
                     let ctx = &mut self.ctx[..l];
                     for (o, cq) in ctx.iter_mut().zip(c.chunks_exact(nn)) {
-                        *o = cq.iter().zip(x_next).map(|(p, q)| p * q).sum();
+                        *o = bunch_kaufman::dot(cq, x_next);
                     }
                     let z = &self.z[next.z_off..next.z_off + n * l];
                     for (zq, &f) in z.chunks_exact(n).zip(ctx.iter()) {
