@@ -75,6 +75,11 @@ pub fn fly_all(
             replay::replay(&opts.out_dir.join("flight.log"), Duration::from_secs(300))
                 .map_err(|e| e.to_string())
         });
+        match &replay {
+            Some(Ok(o)) if !o.all_identical() => eprintln!("{o}"),
+            Some(Err(e)) => eprintln!("{}: replay failed: {e}", sc.name),
+            _ => {}
+        }
         rows.push(Row {
             scenario: sc.name.clone(),
             report,

@@ -50,6 +50,11 @@ pub struct Mismatch {
     pub plan_id: u64,
     /// The fields whose bytes differ (`compute_ms` ignored).
     pub fields: Vec<&'static str>,
+    /// Quality flag and compute time of the logged and the replayed plan: a plan stopped
+    /// by its deadline (not `Optimal`, or a compute time near the budget) depends on the
+    /// machine's speed at the time, not only on its inputs.
+    pub logged: (u32, f64),
+    pub replayed: (u32, f64),
 }
 
 /// What a replay found.
@@ -95,9 +100,13 @@ impl std::fmt::Display for ReplayOutcome {
         for m in &self.mismatches {
             writeln!(
                 f,
-                "  plan {} differs in: {}",
+                "  plan {} differs in: {} (quality {} / {}, compute {:.0} / {:.0} ms, logged / replayed)",
                 m.plan_id,
-                m.fields.join(", ")
+                m.fields.join(", "),
+                m.logged.0,
+                m.replayed.0,
+                m.logged.1,
+                m.replayed.1
             )?;
         }
         write!(
@@ -281,6 +290,8 @@ pub fn replay(log: &Path, timeout: Duration) -> Result<ReplayOutcome, ReplayErro
             mismatches.push(Mismatch {
                 plan_id: a.plan_id,
                 fields: differing_fields(&ba, &bb),
+                logged: (a.quality, a.compute_ms),
+                replayed: (b.quality, b.compute_ms),
             });
         }
     }
@@ -293,4 +304,39 @@ pub fn replay(log: &Path, timeout: Duration) -> Result<ReplayOutcome, ReplayErro
         identical,
         mismatches,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A mismatch names the differing fields and both plans' quality and compute time, so
+    /// a plan cut by its deadline (machine speed) can be told from a nondeterministic one.
+    #[test]
+    fn a_mismatch_reports_the_fields_quality_and_compute_time() {
+        let o = ReplayOutcome {
+            scenario: "s".into(),
+            lock_step: true,
+            inputs: 10,
+            plans_logged: 1,
+            plans_replayed: 1,
+            identical: 0,
+            mismatches: vec![Mismatch {
+                plan_id: 3,
+                fields: vec!["samples", "cost"],
+                logged: (1, 420.0),
+                replayed: (2, 2001.0),
+            }],
+        };
+        assert!(!o.all_identical());
+        let text = o.to_string();
+        assert!(
+            text.contains("plan 3 differs in: samples, cost (quality 1 / 2, compute 420 / 2001 ms"),
+            "{text}"
+        );
+        assert!(
+            text.ends_with("PLANS DIFFER") || text.contains("PLANS DIFFER"),
+            "{text}"
+        );
+    }
 }
