@@ -20,7 +20,7 @@ use counting_alloc::allocations_in;
 
 #[path = "support/planned.rs"]
 mod planned;
-use planned::{clock, planned};
+use planned::{clock, planned, transcribed};
 
 /// Cold solves of `name` on a 5-point mesh from the hybrid planner's plan, with FERAL and
 /// with the structured backend: both converge, to the same objective within 1e-5 of it
@@ -34,10 +34,7 @@ fn same_objective(name: &str) {
         .into_iter()
         .enumerate()
     {
-        let mut tr = Transcription::new(&p, &mesh, &guess, &TranscriptionSettings::default());
-        let mut x = vec![0.0; tr.n_vars()];
-        tr.initial_point(&guess, &mut x);
-        tr.obj_scale = 1.0 / tr.objective(&x).abs().max(1e-3);
+        let (tr, x) = transcribed(&p, &mesh, &guess);
         let start = PrimalDual {
             x,
             ..PrimalDual::default()

@@ -148,13 +148,10 @@ fn thread_slices(pid: u32) -> Vec<(String, u64)> {
 /// starts (the solve thread would inherit it).
 #[test]
 fn the_message_thread_runs_with_the_short_scheduler_slice_and_the_solve_thread_without() {
-    let release = std::fs::read_to_string("/proc/sys/kernel/osrelease").unwrap_or_default();
-    let mut v = release.trim().split(|c: char| !c.is_ascii_digit());
-    let mut num = || v.next().and_then(|x| x.parse::<u32>().ok()).unwrap_or(0);
-    let kernel = (num(), num());
+    let kernel = wingman_planner::service::sched::kernel_release();
     let slices = thread_slices(std::process::id());
     if kernel < (6, 12) || slices.is_empty() {
-        eprintln!("kernel {release}: no per-thread slice to check");
+        eprintln!("kernel {kernel:?}: no per-thread slice to check");
         return;
     }
     let default = slices[0].1;

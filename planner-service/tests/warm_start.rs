@@ -17,7 +17,7 @@ use wingman_planner::trajectory::Trajectory;
 
 #[path = "support/planned.rs"]
 mod planned;
-use planned::{clock, planned};
+use planned::{clock, planned, transcribed};
 
 /// A converged solve of `name` on a uniform mesh of `points` per `interval_s`, started
 /// from the hybrid planner's own plan (a good guess in the right basin).
@@ -46,10 +46,7 @@ fn solve_counted(
     guess: &Trajectory,
     warm: Option<(&Transcription, &PrimalDual)>,
 ) -> (Transcription, (usize, Option<PrimalDual>)) {
-    let mut tr = Transcription::new(p, mesh, guess, &TranscriptionSettings::default());
-    let mut x = vec![0.0; tr.n_vars()];
-    tr.initial_point(guess, &mut x);
-    tr.obj_scale = 1.0 / tr.objective(&x).abs().max(1e-3);
+    let (tr, x) = transcribed(p, mesh, guess);
     let mut start = PrimalDual::default();
     let is_warm = warm.is_some_and(|(from, d)| transfer(from, d, &tr, &mut start));
     start.x = x;

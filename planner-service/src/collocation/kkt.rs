@@ -406,14 +406,19 @@ impl Workspace {
         Some(ws)
     }
 
-    /// Factorises the matrix with nonzeros `values`. `None`: a pivot under `floor` (or a
-    /// zero pivot column); otherwise the number of negative eigenvalues.
+    /// Factorises the matrix with nonzeros `values`. `None`: a non-finite entry, a pivot
+    /// under `floor` or a zero pivot column; otherwise the number of negative eigenvalues.
     fn factor(&mut self, values: &[f64], floor: f64) -> Option<usize> {
         self.dense.iter_mut().for_each(|v| *v = 0.0);
         self.k_max = 0.0;
+        let mut finite = true;
         for (&d, &v) in self.dest.iter().zip(values) {
             self.dense[d] += v;
             self.k_max = self.k_max.max(v.abs());
+            finite &= v.is_finite();
+        }
+        if !finite {
+            return None;
         }
         let nb = self.border.len();
         let (a_all, rest) = self.dense.split_at_mut(self.c_base);
@@ -774,13 +779,7 @@ impl SparseSymLinearSolverInterface for StructuredKkt {
             return self.feral_solve(new_matrix, ia, ja, nrhs, rhs_vals, check, expected);
         };
         if new_matrix {
-            let finite = self.values.iter().all(|v| v.is_finite());
-            let neg = if finite {
-                ws.factor(&self.values, self.floor)
-            } else {
-                None
-            };
-            let Some(neg) = neg else {
+            let Some(neg) = ws.factor(&self.values, self.floor) else {
                 FERAL_FALLBACKS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 return self.feral_solve(true, ia, ja, nrhs, rhs_vals, check, expected);
             };

@@ -65,11 +65,11 @@ pub struct NlpSettings {
     /// point is a minimum, and leaves along negative curvature if not. 3-25 ms per solve
     /// on the canonical scenarios.
     pub second_order_check: bool,
-    /// The linear solver of the KKT systems: FERAL, or block elimination over the mesh
-    /// intervals ([`super::kkt`]; FERAL where the structure does not hold, and for the
-    /// 3-D KKTs, whose border is too large for its dense factorisation to pay). The
+    /// The linear solver of the KKT systems: FERAL, or block elimination along the chain
+    /// of mesh intervals ([`super::kkt`]; FERAL where the structure does not hold). The
     /// restoration phase keeps FERAL either way. Structured by default: on the canonical
-    /// scenarios (probe, 3 seeds) 2-D plans 13-37 % faster, the same costs.
+    /// scenarios (probe, 3 seeds, same window) 38-62 % less plan time, the same costs
+    /// (docs/BENCHMARKS.md).
     pub kkt: KktSolver,
     /// Initial barrier parameter of a cold start (`None`: the solver's default, 0.1).
     pub mu_init: Option<f64>,

@@ -108,6 +108,15 @@ pub fn thread_slice() -> std::io::Result<Option<Duration>> {
     Ok((fair && attr.sched_runtime > 0).then(|| Duration::from_nanos(attr.sched_runtime)))
 }
 
+/// The running kernel's release as (major, minor), from `/proc/sys/kernel/osrelease`
+/// ((0, 0) if it cannot be read): per-thread slices need 6.12.
+pub fn kernel_release() -> (u32, u32) {
+    let r = std::fs::read_to_string("/proc/sys/kernel/osrelease").unwrap_or_default();
+    let mut it = r.trim().split(|c: char| !c.is_ascii_digit());
+    let mut num = || it.next().and_then(|v| v.parse().ok()).unwrap_or(0);
+    (num(), num())
+}
+
 fn thread_attr() -> std::io::Result<SchedAttr> {
     let mut attr = SchedAttr::default();
     // SAFETY: `attr` is writable for the size passed; pid 0 is the calling thread.
@@ -130,15 +139,6 @@ fn thread_attr() -> std::io::Result<SchedAttr> {
 mod tests {
     use super::*;
 
-    /// The kernel's release as (major, minor), from `uname -r`.
-    fn kernel() -> (u32, u32) {
-        let r = std::fs::read_to_string("/proc/sys/kernel/osrelease").unwrap_or_default();
-        let mut it = r.trim().split(|c: char| !c.is_ascii_digit());
-        let major = it.next().and_then(|v| v.parse().ok()).unwrap_or(0);
-        let minor = it.next().and_then(|v| v.parse().ok()).unwrap_or(0);
-        (major, minor)
-    }
-
     #[test]
     fn the_slice_set_is_the_slice_the_kernel_reports_and_a_thread_started_before_keeps_its_own() {
         let mine = thread_slice().expect("sched_getattr");
@@ -153,7 +153,7 @@ mod tests {
         .join()
         .expect("thread");
         let (before, outcome, after) = set;
-        if kernel() >= (6, 12) {
+        if kernel_release() >= (6, 12) {
             assert_eq!(outcome, SliceOutcome::Applied(Duration::from_micros(250)));
             assert_eq!(after, Some(Duration::from_micros(250)));
             assert_ne!(before, Some(Duration::from_micros(250)));
@@ -168,11 +168,11 @@ mod tests {
     fn a_slice_outside_the_kernels_range_is_clamped() {
         std::thread::spawn(|| {
             let outcome = set_thread_slice(Duration::from_micros(1)).expect("sched_setattr");
-            if kernel() >= (6, 12) {
+            if kernel_release() >= (6, 12) {
                 assert_eq!(outcome, SliceOutcome::Applied(MIN_SLICE));
             }
             let outcome = set_thread_slice(Duration::from_secs(1)).expect("sched_setattr");
-            if kernel() >= (6, 12) {
+            if kernel_release() >= (6, 12) {
                 assert_eq!(outcome, SliceOutcome::Applied(MAX_SLICE));
             }
         })

@@ -1,9 +1,11 @@
 //! A bundled scenario's problem and the hybrid planner's plan for it (default settings, a
-//! generous deadline): a good guess in the right basin for tests of the collocation layer.
+//! generous deadline): a good guess in the right basin for tests of the collocation layer,
+//! and its transcription on a mesh.
 
 use std::time::Duration;
 
 use wingman_planner::clock::{Deadline, MonotonicClock};
+use wingman_planner::collocation::{Mesh, Transcription, TranscriptionSettings};
 use wingman_planner::hybrid::{Planner, PlannerSettings};
 use wingman_planner::problem::Problem;
 use wingman_planner::scenario::bundled;
@@ -26,4 +28,14 @@ pub fn planned(name: &str) -> (Problem, Trajectory) {
         )
         .unwrap();
     (p, plan.trajectory)
+}
+
+/// The transcription of `p` on `mesh` around `guess`, with the guess as its scaled initial
+/// point and the objective scaled to about 1 there (as the planner scales it).
+pub fn transcribed(p: &Problem, mesh: &Mesh, guess: &Trajectory) -> (Transcription, Vec<f64>) {
+    let mut tr = Transcription::new(p, mesh, guess, &TranscriptionSettings::default());
+    let mut x = vec![0.0; tr.n_vars()];
+    tr.initial_point(guess, &mut x);
+    tr.obj_scale = 1.0 / tr.objective(&x).abs().max(1e-3);
+    (tr, x)
 }
