@@ -172,14 +172,16 @@ struct Block {
     a_off: usize,
     /// Border columns of `W_k` (the original ones and the fill from the previous block):
     /// `border_cols[b_first..b_first + m]` (border-local, increasing); `W_k` (`n × m`) at
-    /// `w_off` in the `W` part of `dense`, `Y_k = Ã_kk⁻¹ W_k` at `y_off` in `y`.
+    /// `w_off` in the `W` part of `dense`, `V_k = D⁻¹ L⁻¹ Pᵀ W_k` (with `Ã_kk = P L D Lᵀ
+    /// Pᵀ`) at `y_off` in `y`.
     m: usize,
     b_first: usize,
     w_off: usize,
     y_off: usize,
     /// Link to the previous block: its local indices `links[l_first..l_first + l]`
     /// (increasing) that this block touches; `C_k` (`n × l`, this block's rows, those
-    /// columns) at `c_off` in the `C` part of `dense`, `Z_k = Ã_{k-1}⁻¹ E_L` (`n_{k-1} × l`) at `z_off` in `z`.
+    /// columns) at `c_off` in the `C` part of `dense`, `D⁻¹ L⁻¹ Pᵀ E_L` of block `k - 1`'s
+    /// factors (`n_{k-1} × l`) at `z_off` in `z`.
     l: usize,
     l_first: usize,
     c_off: usize,
@@ -209,10 +211,17 @@ struct Workspace {
     z: Vec<f64>,
     /// Pivots: the blocks' at their `first`, `S`'s after them.
     piv: Vec<i32>,
-    /// Factorisation scratch: `M = Z[L, :]` (`l × l`) and `C M` (`n × l`).
+    /// Factorisation scratch: `L⁻¹ Pᵀ W_k`, `L⁻¹ Pᵀ E_L`, `M = E_Lᵀ Ã⁻¹ E_L` (`l × l`),
+    /// `E_Lᵀ Ã⁻¹ W_k` (`l × m`) and `C M` (`n × l`).
+    g_w: Vec<f64>,
+    g_l: Vec<f64>,
+    /// The blocked Bunch–Kaufman's panel scratch, for the largest block or border.
+    bk_work: Vec<f64>,
     m_link: Vec<f64>,
+    y_link: Vec<f64>,
     cm: Vec<f64>,
-    /// Solve scratch: block parts and border part of one right-hand side, and `Cᵀ x`.
+    /// Solve scratch: block parts and border part of one right-hand side, and `Cᵀ x` (the
+    /// backward pass) or `E_Lᵀ Ã⁻¹ t` (the forward pass).
     work: Vec<f64>,
     work_b: Vec<f64>,
     ctx: Vec<f64>,
@@ -304,7 +313,7 @@ impl Workspace {
             ..Workspace::default()
         };
         let (mut first, mut a_len, mut c_len, mut w_len, mut z_len) = (0, 0, 0, 0, 0);
-        let (mut max_l, mut max_nl) = (0, 0);
+        let (mut max_l, mut max_nl, mut max_nm, mut max_zl, mut max_m) = (0, 0, 0, 0, 0);
         for b in 0..count {
             let (n, m, l) = (sizes[b], touches[b].len(), linked[b].len());
             ws.blocks.push(Block {
@@ -336,9 +345,12 @@ impl Workspace {
             w_len += n * m;
             if l > 0 {
                 z_len += sizes[b - 1] * l;
+                max_zl = max_zl.max(sizes[b - 1] * l);
             }
             max_l = max_l.max(l);
+            max_m = max_m.max(m);
             max_nl = max_nl.max(n * l);
+            max_nm = max_nm.max(n * m);
         }
         ws.c_base = a_len;
         ws.w_base = a_len + c_len;
@@ -355,7 +367,12 @@ impl Workspace {
         ws.y = vec![0.0; w_len];
         ws.z = vec![0.0; z_len];
         ws.piv = vec![0; first + nb];
+        ws.g_w = vec![0.0; max_nm];
+        let largest = ws.blocks.iter().map(|b| b.n).max().unwrap_or(0).max(nb);
+        ws.bk_work = vec![0.0; bunch_kaufman::work_len(largest)];
+        ws.g_l = vec![0.0; max_zl];
         ws.m_link = vec![0.0; max_l * max_l];
+        ws.y_link = vec![0.0; max_l * max_m];
         ws.cm = vec![0.0; max_nl];
         ws.work = vec![0.0; first];
         ws.work_b = vec![0.0; nb];
@@ -435,44 +452,60 @@ impl Workspace {
             let (w_lo, w_hi) = w_all.split_at_mut(blk.w_off + n * m);
             let w = &w_lo[blk.w_off..];
             let piv = &mut self.piv[blk.first..blk.first + n];
-            let inertia = bunch_kaufman::factor(a, n, piv)?;
+            let inertia = bunch_kaufman::factor(a, n, piv, &mut self.bk_work)?;
             if inertia.min_pivot < floor {
                 return None;
             }
             negative += inertia.negative;
             let (a, piv) = (&*a, &*piv);
-            // Y_k = Ã_kk⁻¹ W_k.
-            let y = &mut self.y[blk.y_off..blk.y_off + n * m];
-            y.copy_from_slice(w);
-            bunch_kaufman::solve_many(a, n, piv, y, m);
-            let y = &*y;
-            // S -= W_kᵀ Y_k over the lower triangle (border columns increase).
+            // G = L⁻¹ Pᵀ W_k and V_k = D⁻¹ G, so that uᵀ Ã_kk⁻¹ W_k = (L⁻¹ Pᵀ u)ᵀ V_k: half
+            // a solve per column (the solves do the other half).
+            let g = &mut self.g_w[..n * m];
+            g.copy_from_slice(w);
+            bunch_kaufman::forward_many(a, n, piv, g, m);
+            let g = &*g;
+            let v = &mut self.y[blk.y_off..blk.y_off + n * m];
+            v.copy_from_slice(g);
+            bunch_kaufman::scale_by_d_inv(a, n, piv, v, m);
+            let v = &*v;
+            // S -= W_kᵀ Ã_kk⁻¹ W_k = Gᵀ V over the lower triangle (border columns increase).
             let cols = &self.border_cols[blk.b_first..blk.b_first + m];
             for (jj, &bj) in cols.iter().enumerate() {
-                let yj = &y[jj * n..(jj + 1) * n];
+                let vj = &v[jj * n..(jj + 1) * n];
                 for (ii, &bi) in cols.iter().enumerate().skip(jj) {
-                    let wi = &w[ii * n..(ii + 1) * n];
-                    let dot = bunch_kaufman::dot(wi, yj);
-                    s[bi + bj * nb] -= dot;
+                    let gi = &g[ii * n..(ii + 1) * n];
+                    s[bi + bj * nb] -= bunch_kaufman::dot(gi, vj);
                 }
             }
-            // The next block, if linked: Z = Ã_kk⁻¹ E_L, M = Z[L, :],
-            // Ã_{k+1} -= C M Cᵀ and W_{k+1} -= C Y_k[L, :].
+            // The next block, if linked: with G_L = L⁻¹ Pᵀ E_L and V_L = D⁻¹ G_L,
+            // M = E_Lᵀ Ã_kk⁻¹ E_L = G_Lᵀ V_L and E_Lᵀ Ã_kk⁻¹ W_k = G_Lᵀ V;
+            // Ã_{k+1} -= C M Cᵀ and W_{k+1} -= C E_Lᵀ Ã_kk⁻¹ W_k.
             let l = next.l;
             if l == 0 {
                 continue;
             }
             let links = &self.links[next.l_first..next.l_first + l];
-            let z = &mut self.z[next.z_off..next.z_off + n * l];
-            z.iter_mut().for_each(|v| *v = 0.0);
-            for (col, &li) in z.chunks_exact_mut(n).zip(links) {
+            let gl = &mut self.g_l[..n * l];
+            gl.iter_mut().for_each(|x| *x = 0.0);
+            for (col, &li) in gl.chunks_exact_mut(n).zip(links) {
                 col[li] = 1.0;
             }
-            bunch_kaufman::solve_many(a, n, piv, z, l);
+            bunch_kaufman::forward_many(a, n, piv, gl, l);
+            let gl = &*gl;
+            let vl = &mut self.z[next.z_off..next.z_off + n * l];
+            vl.copy_from_slice(gl);
+            bunch_kaufman::scale_by_d_inv(a, n, piv, vl, l);
+            let vl = &*vl;
             let mm = &mut self.m_link[..l * l];
-            for (j, col) in z.chunks_exact(n).enumerate() {
-                for (i, &li) in links.iter().enumerate() {
-                    mm[i + j * l] = col[li];
+            for (j, vj) in vl.chunks_exact(n).enumerate() {
+                for (i, gi) in gl.chunks_exact(n).enumerate() {
+                    mm[i + j * l] = bunch_kaufman::dot(gi, vj);
+                }
+            }
+            let yl = &mut self.y_link[..l * m];
+            for (j, vj) in v.chunks_exact(n).enumerate() {
+                for (q, gq) in gl.chunks_exact(n).enumerate() {
+                    yl[q + j * l] = bunch_kaufman::dot(gq, vj);
                 }
             }
             let c = &c_all[next.c_off..next.c_off + nn * l];
@@ -509,10 +542,9 @@ impl Workspace {
                 if pj == usize::MAX {
                     continue;
                 }
-                let yj = &y[pj * n..(pj + 1) * n];
+                let ylj = &yl[pj * l..(pj + 1) * l];
                 let out = &mut w_next[jj * nn..(jj + 1) * nn];
-                for (q, &li) in links.iter().enumerate() {
-                    let f = yj[li];
+                for (q, &f) in ylj.iter().enumerate() {
                     if f != 0.0 {
                         for (o, &cv) in out.iter_mut().zip(&c[q * nn..(q + 1) * nn]) {
                             *o -= cv * f;
@@ -523,7 +555,7 @@ impl Workspace {
         }
         if nb > 0 {
             let piv = &mut self.piv[self.members.len()..];
-            let inertia = bunch_kaufman::factor(s, nb, piv)?;
+            let inertia = bunch_kaufman::factor(s, nb, piv, &mut self.bk_work)?;
             if inertia.min_pivot < floor {
                 return None;
             }
@@ -572,22 +604,19 @@ impl Workspace {
         for (w, &i) in self.work_b.iter_mut().zip(&self.border) {
             *w = b[i];
         }
-        // Forward: t_k = b_k - C_k u_{k-1}[L_k], u_k = Ã_kk⁻¹ t_k, b_G -= Y_kᵀ t_k.
+        // Forward, with Ã_kk = P L D Lᵀ Pᵀ: t_k = b_k - C_k u_{k-1}[L_k], h = L⁻¹ Pᵀ t_k,
+        // b_G -= W_kᵀ Ã_kk⁻¹ t_k = V_kᵀ h, u_k[L_{k+1}] = E_Lᵀ Ã_kk⁻¹ t_k = V_Lᵀ h (in
+        // `ctx`, for the next block), and D⁻¹ h kept for the backward pass.
         for k in 0..self.blocks.len() {
             let blk = self.blocks[k];
             let (n, m, l) = (blk.n, blk.m, blk.l);
-            let (done, now) = self.work.split_at_mut(blk.first);
-            let t = &mut now[..n];
+            let t = &mut self.work[blk.first..blk.first + n];
             for (ti, &i) in t.iter_mut().zip(&self.members[blk.first..blk.first + n]) {
                 *ti = b[i];
             }
             if l > 0 {
-                let prev = self.blocks[k - 1];
-                let u_prev = &done[prev.first..prev.first + prev.n];
                 let c = &c_all[blk.c_off..blk.c_off + n * l];
-                let links = &self.links[blk.l_first..blk.l_first + l];
-                for (cq, &li) in c.chunks_exact(n).zip(links) {
-                    let f = u_prev[li];
+                for (cq, &f) in c.chunks_exact(n).zip(&self.ctx[..l]) {
                     if f != 0.0 {
                         for (ti, &cv) in t.iter_mut().zip(cq) {
                             *ti -= cv * f;
@@ -595,31 +624,39 @@ impl Workspace {
                     }
                 }
             }
-            let y = &self.y[blk.y_off..blk.y_off + n * m];
-            let cols = &self.border_cols[blk.b_first..blk.b_first + m];
-            for (yj, &bj) in y.chunks_exact(n).zip(cols) {
-                let dot = bunch_kaufman::dot(yj, t);
-                self.work_b[bj] -= dot;
-            }
             let a = &self.dense[blk.a_off..blk.a_off + n * n];
-            bunch_kaufman::solve(a, n, &self.piv[blk.first..blk.first + n], t);
+            let piv = &self.piv[blk.first..blk.first + n];
+            bunch_kaufman::forward_many(a, n, piv, t, 1);
+            let v = &self.y[blk.y_off..blk.y_off + n * m];
+            let cols = &self.border_cols[blk.b_first..blk.b_first + m];
+            for (vj, &bj) in v.chunks_exact(n).zip(cols) {
+                self.work_b[bj] -= bunch_kaufman::dot(vj, t);
+            }
+            if let Some(&next) = self.blocks.get(k + 1) {
+                let vl = &self.z[next.z_off..next.z_off + n * next.l];
+                for (o, vq) in self.ctx.iter_mut().zip(vl.chunks_exact(n)) {
+                    *o = bunch_kaufman::dot(vq, t);
+                }
+            }
+            bunch_kaufman::scale_by_d_inv(a, n, piv, t, 1);
         }
         if nb > 0 {
             bunch_kaufman::solve(s, nb, &self.piv[self.members.len()..], &mut self.work_b);
         }
-        // Backward: x_k = u_k - Y_k x_G - Z_{k+1} (C_{k+1}ᵀ x_{k+1}).
+        // Backward: x_k = Ã_kk⁻¹ (t_k - W_k x_G - E_L C_{k+1}ᵀ x_{k+1})
+        //               = P L⁻ᵀ (D⁻¹ h - V_k x_G - V_L C_{k+1}ᵀ x_{k+1}).
         for k in (0..self.blocks.len()).rev() {
             let blk = self.blocks[k];
             let (n, m) = (blk.n, blk.m);
             let (now, later) = self.work.split_at_mut(blk.first + n);
             let t = &mut now[blk.first..];
-            let y = &self.y[blk.y_off..blk.y_off + n * m];
+            let v = &self.y[blk.y_off..blk.y_off + n * m];
             let cols = &self.border_cols[blk.b_first..blk.b_first + m];
-            for (yj, &bj) in y.chunks_exact(n).zip(cols) {
-                let v = self.work_b[bj];
-                if v != 0.0 {
-                    for (ti, &yv) in t.iter_mut().zip(yj) {
-                        *ti -= yv * v;
+            for (vj, &bj) in v.chunks_exact(n).zip(cols) {
+                let f = self.work_b[bj];
+                if f != 0.0 {
+                    for (ti, &vv) in t.iter_mut().zip(vj) {
+                        *ti -= vv * f;
                     }
                 }
             }
@@ -632,16 +669,18 @@ impl Workspace {
                     for (o, cq) in ctx.iter_mut().zip(c.chunks_exact(nn)) {
                         *o = bunch_kaufman::dot(cq, x_next);
                     }
-                    let z = &self.z[next.z_off..next.z_off + n * l];
-                    for (zq, &f) in z.chunks_exact(n).zip(ctx.iter()) {
+                    let vl = &self.z[next.z_off..next.z_off + n * l];
+                    for (vq, &f) in vl.chunks_exact(n).zip(ctx.iter()) {
                         if f != 0.0 {
-                            for (ti, &zv) in t.iter_mut().zip(zq) {
-                                *ti -= zv * f;
+                            for (ti, &vv) in t.iter_mut().zip(vq) {
+                                *ti -= vv * f;
                             }
                         }
                     }
                 }
             }
+            let a = &self.dense[blk.a_off..blk.a_off + n * n];
+            bunch_kaufman::backward_many(a, n, &self.piv[blk.first..blk.first + n], t, 1);
             for (&ti, &i) in t.iter().zip(&self.members[blk.first..blk.first + n]) {
                 b[i] = ti;
             }

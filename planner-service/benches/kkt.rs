@@ -1,0 +1,80 @@
+//! The dense Bunch–Kaufman kernels of the structured KKT backend on blocks shaped like the
+//! LGR collocation's (a primal part with 9×9 node blocks, defect rows 30 % dense, a small
+//! negative dual diagonal): 42 rows (a 2-D block), 64 and 96 (3-D ranking and working
+//! meshes). Blocked (`dsytrf`-style panels) against unblocked, each on the dispatched
+//! (AVX2 where present) and the baseline SSE2 path; and one single-column solve.
+//!
+//! `cargo bench -p wingman-planner --bench kkt`
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use rand::{RngExt, SeedableRng};
+use wingman_planner::collocation::bunch_kaufman as bk;
+
+/// A KKT-shaped symmetric block of `nx` primal and `m` dual rows (full storage).
+fn kkt_block(nx: usize, m: usize, seed: u64) -> Vec<f64> {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let n = nx + m;
+    let mut k = vec![0.0; n * n];
+    for i in 0..nx {
+        k[i + i * n] = rng.random_range(0.5..2.0);
+        for j in 0..i {
+            if i / 9 == j / 9 {
+                let v: f64 = rng.random_range(-0.3..0.3);
+                k[i + j * n] = v;
+                k[j + i * n] = v;
+            }
+        }
+    }
+    for r in nx..n {
+        k[r + r * n] = -1e-8;
+        for c in 0..nx {
+            if rng.random_range(0.0..1.0) < 0.3 {
+                let v = rng.random_range(-1.0..1.0);
+                k[r + c * n] = v;
+                k[c + r * n] = v;
+            }
+        }
+    }
+    k
+}
+
+fn factor(c: &mut Criterion) {
+    let mut g = c.benchmark_group("bunch_kaufman");
+    for (nx, m) in [(24, 18), (36, 28), (52, 44)] {
+        let n = nx + m;
+        let k = kkt_block(nx, m, n as u64);
+        let mut a = k.clone();
+        let mut piv = vec![0i32; n];
+        let mut work = vec![0.0; bk::work_len(n)];
+        type Factor = fn(&mut [f64], usize, &mut [i32], &mut [f64]) -> Option<bk::Inertia>;
+        let paths: [(&str, Factor, bool); 4] = [
+            ("blocked", bk::factor, true),
+            ("unblocked", bk::factor, false),
+            ("blocked sse2", bk::factor_portable, true),
+            ("unblocked sse2", bk::factor_portable, false),
+        ];
+        for (name, f, blocked) in paths {
+            g.bench_function(format!("factor n={n} {name}"), |b| {
+                b.iter(|| {
+                    a.copy_from_slice(&k);
+                    let w: &mut [f64] = if blocked { &mut work } else { &mut [] };
+                    f(&mut a, n, &mut piv, w).expect("nonsingular")
+                })
+            });
+        }
+        a.copy_from_slice(&k);
+        bk::factor(&mut a, n, &mut piv, &mut work).expect("nonsingular");
+        let rhs: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+        let mut x = rhs.clone();
+        g.bench_function(format!("solve n={n}"), |b| {
+            b.iter(|| {
+                x.copy_from_slice(&rhs);
+                bk::solve(&a, n, &piv, &mut x);
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, factor);
+criterion_main!(benches);
