@@ -5,10 +5,12 @@
 //! `cargo run --release -p wingman-planner --example probe -- [NAME-FILTER] [RUNS]`
 //!
 //! Overrides: `PROBE_STARTS`, `PROBE_FINALISTS`, `PROBE_ROUNDS`, `PROBE_RANK_PTS`,
-//! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`,
+//! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`, `PROBE_DEFECT_TOL`
+//! (the refinement's tolerance, m),
 //! `PROBE_NLP="name=value;name=value"` (extra solver options; `PROBE_RANK_NLP` and
 //! `PROBE_FINAL_NLP` for the ranking or the working-mesh solves only); `PROBE_FIRST_SEED` (1);
 //! `PROBE_KKT=feral|structured` (the KKT linear solver of every NLP solve);
+//! `PROBE_ITS=1` prints every plan's NLP iterations per solve (deterministic, unlike times);
 //! `PROBE_OUT=DIR` writes
 //! each plan's `plan.json` / `plan.csv` into `DIR/NAME-SEED/` for the judge.
 
@@ -60,6 +62,9 @@ fn main() {
     }
     if let Some(v) = env("PROBE_MESH_S") {
         s.mesh.interval_s = v;
+    }
+    if let Some(v) = env("PROBE_DEFECT_TOL") {
+        s.refine.defect_tol_m = v;
     }
     if let Some(v) = env("PROBE_THREADS") {
         s.threads = v;
@@ -172,6 +177,10 @@ fn main() {
                         .map(|c| format!("{:.4}", c / best))
                         .collect::<Vec<_>>()
                 );
+            }
+            if std::env::var("PROBE_ITS").is_ok() {
+                // One line per plan: `ITS name seed ratio [iterations per solve]`.
+                println!("ITS {name} {seed} {ratio:.5} {:?}", out.nlp.iterations);
             }
             if seed == 1 {
                 line = format!(
