@@ -193,6 +193,10 @@ struct Block {
 struct Workspace {
     /// Destination in `dense` of each input nonzero.
     dest: Vec<usize>,
+    /// The input nonzeros grouped by the block whose `A`, `C` or `W` they land in (the
+    /// border's `S` last): group `b` is `by_owner[owner_start[b]..owner_start[b + 1]]`.
+    by_owner: Vec<u32>,
+    owner_start: Vec<usize>,
     blocks: Vec<Block>,
     members: Vec<usize>,
     border_cols: Vec<usize>,
@@ -420,29 +424,84 @@ impl Workspace {
             };
             ws.dest.push(d);
         }
+        // Group the nonzeros by the block that takes them (the border last), so that each
+        // block is assembled just before it is needed, while it is in cache.
+        let owner_of = |d: usize| -> usize {
+            if d >= ws.s_off {
+                return count;
+            }
+            let (base, off): (usize, fn(&Block) -> usize) = if d >= ws.w_base {
+                (ws.w_base, |b| b.w_off)
+            } else if d >= ws.c_base {
+                (ws.c_base, |b| b.c_off)
+            } else {
+                (0, |b| b.a_off)
+            };
+            // The last block whose region starts at or before `d` (regions are in block
+            // order; empty ones share their start with the next block's).
+            ws.blocks.partition_point(|b| base + off(b) <= d) - 1
+        };
+        let owners: Vec<usize> = ws.dest.iter().map(|&d| owner_of(d)).collect();
+        ws.owner_start = vec![0; count + 2];
+        for &o in &owners {
+            ws.owner_start[o + 1] += 1;
+        }
+        for b in 0..=count {
+            ws.owner_start[b + 1] += ws.owner_start[b];
+        }
+        ws.by_owner = vec![0; owners.len()];
+        let mut fill = ws.owner_start.clone();
+        for (i, &o) in owners.iter().enumerate() {
+            ws.by_owner[fill[o]] = i as u32;
+            fill[o] += 1;
+        }
         Some(ws)
     }
 
     /// Factorises the matrix with nonzeros `values`. `None`: a non-finite entry, a pivot
     /// under `floor` or a zero pivot column; otherwise the number of negative eigenvalues.
-    fn factor(&mut self, values: &[f64], floor: f64) -> Option<usize> {
-        self.dense.iter_mut().for_each(|v| *v = 0.0);
-        self.k_max = 0.0;
+    /// Assembles group `owner` (a block's `A`, `C` and `W`, or with `owner` = the block
+    /// count the border's `S`) from `values`; `None` on a non-finite entry.
+    fn assemble(&mut self, owner: usize, values: &[f64]) -> Option<()> {
+        let nb = self.border.len();
+        match self.blocks.get(owner) {
+            Some(b) => {
+                self.dense[b.a_off..b.a_off + b.n * b.n].fill(0.0);
+                let c = self.c_base + b.c_off;
+                self.dense[c..c + b.n * b.l].fill(0.0);
+                let w = self.w_base + b.w_off;
+                self.dense[w..w + b.n * b.m].fill(0.0);
+            }
+            None => self.dense[self.s_off..self.s_off + nb * nb].fill(0.0),
+        }
         let mut finite = true;
-        for (&d, &v) in self.dest.iter().zip(values) {
-            self.dense[d] += v;
+        let group = &self.by_owner[self.owner_start[owner]..self.owner_start[owner + 1]];
+        for &i in group {
+            let v = values[i as usize];
+            self.dense[self.dest[i as usize]] += v;
             self.k_max = self.k_max.max(v.abs());
             finite &= v.is_finite();
         }
-        if !finite {
-            return None;
+        finite.then_some(())
+    }
+
+    fn factor(&mut self, values: &[f64], floor: f64) -> Option<usize> {
+        let count = self.blocks.len();
+        self.k_max = 0.0;
+        self.assemble(count, values)?;
+        if count > 0 {
+            self.assemble(0, values)?;
         }
         let nb = self.border.len();
-        let (a_all, rest) = self.dense.split_at_mut(self.c_base);
-        let (c_all, rest) = rest.split_at_mut(self.w_base - self.c_base);
-        let (w_all, s) = rest.split_at_mut(self.s_off - self.w_base);
         let mut negative = 0;
-        for k in 0..self.blocks.len() {
+        for k in 0..count {
+            // The next block is assembled now: this one's elimination updates it.
+            if k + 1 < count {
+                self.assemble(k + 1, values)?;
+            }
+            let (a_all, rest) = self.dense.split_at_mut(self.c_base);
+            let (c_all, rest) = rest.split_at_mut(self.w_base - self.c_base);
+            let (w_all, s) = rest.split_at_mut(self.s_off - self.w_base);
             let blk = self.blocks[k];
             let next = self.blocks.get(k + 1).copied().unwrap_or_default();
             let (n, m, nn) = (blk.n, blk.m, next.n);
@@ -554,6 +613,7 @@ impl Workspace {
             }
         }
         if nb > 0 {
+            let s = &mut self.dense[self.s_off..self.s_off + nb * nb];
             let piv = &mut self.piv[self.members.len()..];
             let inertia = bunch_kaufman::factor(s, nb, piv, &mut self.bk_work)?;
             if inertia.min_pivot < floor {
