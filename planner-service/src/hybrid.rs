@@ -69,6 +69,8 @@ pub struct PlannerSettings {
     pub ranking_mesh: MeshSettings,
     /// The ranking mesh of 3-D plans.
     pub ranking_mesh_3d: MeshSettings,
+    /// The first barrier parameter of the 3-D ranking solves (`None`: `ranking_nlp`'s).
+    pub ranking_mu_init_3d: Option<f64>,
     /// Largest scaled constraint violation of a ranking solve that still ranks.
     pub ranking_feasibility_tol: f64,
     /// How many of the best-ranked starts are solved again on the working mesh.
@@ -104,16 +106,6 @@ impl Default for PlannerSettings {
                 // (3 ms per 2-D, 8-10 ms per 3-D ranking solve; the same iterations and
                 // plans on the canonical scenarios, seeds 1-3, judged).
                 second_order_check: false,
-                // A small first barrier: the starts are whole paths already (the swarm's
-                // best and seeds), not points to be pushed into the interior. With the
-                // structured KKT backend, on the 15 canonical scenarios (seeds 1-5) 21 %
-                // fewer ranking iterations than the solver's 0.1 (up to 45 % in 3-D, up
-                // to 20 % more on two 2-D scenarios), 7 % more in the working-mesh
-                // solves, plan costs within 0.35 % of the reference (0.1: 0.29 %). 1e-2
-                // cut fewer; with 3e-3 and 3e-4 the working-mesh solve of
-                // 2d-min-time-unavoidable seed 1 reached a neighbouring optimum 0.5 %
-                // higher (docs/BENCHMARKS.md).
-                mu_init: Some(1e-3),
                 ..NlpSettings::default()
             },
             refine: RefineSettings::default(),
@@ -140,6 +132,15 @@ impl Default for PlannerSettings {
                 interval_s: 35.0,
                 min_intervals: 2,
             },
+            // A small first barrier in 3-D: the starts are whole paths already (the
+            // swarm's best and seeds), not points to be pushed into the interior. On the
+            // 3-D canonical scenarios (seeds 1-5) 25 % fewer ranking iterations than the
+            // solver's 0.1 (up to 45 %), 7 % more in the working-mesh solves, costs within
+            // 0.35 % of the reference, cost spread over seeds 1-20 at most 0.13 %. Not in
+            // 2-D: 6 % fewer iterations, but 3 of 40 plans (2d-min-time-avoidable and
+            // 2d-min-time-rendezvous-unavoidable, seeds 1-20) landed 0.7-3.5 % above the
+            // reference (docs/BENCHMARKS.md).
+            ranking_mu_init_3d: Some(1e-3),
             ranking_feasibility_tol: 1e-4,
             finalists: 2,
             warm_mesh_changes: true,
@@ -236,6 +237,8 @@ struct MeshSolve<'a> {
     warm_from: Option<(&'a Transcription, &'a PrimalDual)>,
     /// Do not start with less time than this left.
     min_time: Duration,
+    /// The first barrier parameter, over `nlp_settings`' (`None`: theirs).
+    mu_init: Option<f64>,
 }
 
 /// Solves `job.problem` on `job.mesh` from `job.guess`; `None` if the result is not
@@ -251,6 +254,7 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
         feasibility_tol,
         warm_from,
         min_time,
+        mu_init,
     } = job;
     if deadline.remaining() <= min_time {
         // No time for even one iteration (the longest set-up and first iteration of the
@@ -266,6 +270,9 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
     if refined {
         // A refined mesh starts from the previous solution: a small barrier keeps it.
         nlp.mu_init = Some(nlp_settings.refine_mu_init);
+    }
+    if mu_init.is_some() {
+        nlp.mu_init = mu_init;
     }
     let mut start = PrimalDual::default();
     let warm = match warm_from {
@@ -438,6 +445,11 @@ impl Planner {
                     feasibility_tol: settings.ranking_feasibility_tol,
                     warm_from: None,
                     min_time,
+                    mu_init: if problem.dim() == 3 {
+                        settings.ranking_mu_init_3d
+                    } else {
+                        None
+                    },
                 },
                 deadline,
             )
@@ -502,6 +514,7 @@ impl Planner {
                         .get(order[i].1)
                         .and_then(|s| warm_start_of(s, warm)),
                     min_time,
+                    mu_init: None,
                 },
                 deadline,
             )
@@ -546,6 +559,7 @@ impl Planner {
                     feasibility_tol: settings.nlp.feasibility_tol,
                     warm_from: warm_start_of(&accepted, warm),
                     min_time,
+                    mu_init: None,
                 },
                 deadline,
             )?;
