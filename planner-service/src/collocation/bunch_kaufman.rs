@@ -208,6 +208,41 @@ fn abs_argmax(v: &[f64], offset: usize) -> (usize, f64) {
     (offset + i, m)
 }
 
+/// `dsytf2`'s scaled inverse of the 2×2 pivot `[[d11, d21], [d21, d22]]`.
+struct ScaledInverse {
+    e11: f64,
+    e22: f64,
+    s: f64,
+}
+
+impl ScaledInverse {
+    #[inline(always)]
+    fn of(d11: f64, d21: f64, d22: f64) -> ScaledInverse {
+        let e11 = d22 / d21;
+        let e22 = d11 / d21;
+        let t = 1.0 / (e11 * e22 - 1.0);
+        ScaledInverse {
+            e11,
+            e22,
+            s: t / d21,
+        }
+    }
+
+    /// The multipliers of a row `(x, y)` of the pivot's two columns: `(x, y) D⁻¹`.
+    #[inline(always)]
+    fn multipliers(&self, x: f64, y: f64) -> (f64, f64) {
+        (self.s * (self.e11 * x - y), self.s * (self.e22 * y - x))
+    }
+}
+
+/// Records a 2×2 pivot at `(k, k + 1)` taken after interchanging `k + 1` and `kp`.
+#[inline(always)]
+fn mark_2x2(piv: &mut [i32], k: usize, kp: usize) {
+    let code = -(kp as i32) - 1;
+    piv[k] = code;
+    piv[k + 1] = code;
+}
+
 /// Counts a 1×1 pivot `d` in `inertia`.
 #[inline(always)]
 fn take_1x1(inertia: &mut Inertia, d: f64) {
@@ -359,23 +394,17 @@ fn panel(
             let (d11, d21, d22) = (w[k + kw * n], w[k + 1 + kw * n], w[k + 1 + (kw + 1) * n]);
             take_2x2(inertia, d11, d21, d22);
             if k + 2 < n {
-                // dsytf2's scaled inverse of the 2×2 pivot.
-                let e11 = d22 / d21;
-                let e22 = d11 / d21;
-                let t = 1.0 / (e11 * e22 - 1.0);
-                let s = t / d21;
+                let inv = ScaledInverse::of(d11, d21, d22);
                 for j in k + 2..n {
-                    let (wk, wk1) = (w[j + kw * n], w[j + (kw + 1) * n]);
-                    a[at(n, j, k)] = s * (e11 * wk - wk1);
-                    a[at(n, j, k + 1)] = s * (e22 * wk1 - wk);
+                    let (wk, wk1) = inv.multipliers(w[j + kw * n], w[j + (kw + 1) * n]);
+                    a[at(n, j, k)] = wk;
+                    a[at(n, j, k + 1)] = wk1;
                 }
             }
             a[at(n, k, k)] = d11;
             a[at(n, k + 1, k)] = d21;
             a[at(n, k + 1, k + 1)] = d22;
-            let code = -(kp as i32) - 1;
-            piv[k] = code;
-            piv[k + 1] = code;
+            mark_2x2(piv, k, kp);
             k += 2;
         }
     }
@@ -473,14 +502,9 @@ fn unblocked(
             let (d11, d21, d22) = (a[at(n, k, k)], a[at(n, k + 1, k)], a[at(n, k + 1, k + 1)]);
             take_2x2(inertia, d11, d21, d22);
             if k + 2 < n {
-                // dsytf2's scaled inverse of the 2×2 pivot.
-                let e11 = d22 / d21;
-                let e22 = d11 / d21;
-                let t = 1.0 / (e11 * e22 - 1.0);
-                let s = t / d21;
+                let inv = ScaledInverse::of(d11, d21, d22);
                 for j in k + 2..n {
-                    let wk = s * (e11 * a[at(n, j, k)] - a[at(n, j, k + 1)]);
-                    let wk1 = s * (e22 * a[at(n, j, k + 1)] - a[at(n, j, k)]);
+                    let (wk, wk1) = inv.multipliers(a[at(n, j, k)], a[at(n, j, k + 1)]);
                     let (head, tail) = a.split_at_mut(at(n, 0, j));
                     let col_k = &head[at(n, j, k)..at(n, n, k)];
                     let col_k1 = &head[at(n, j, k + 1)..at(n, n, k + 1)];
@@ -491,9 +515,7 @@ fn unblocked(
                     a[at(n, j, k + 1)] = wk1;
                 }
             }
-            let code = -(kp as i32) - 1;
-            piv[k] = code;
-            piv[k + 1] = code;
+            mark_2x2(piv, k, kp);
             k += 2;
         }
     }

@@ -385,14 +385,16 @@ impl Workspace {
         ws.res = vec![0.0; dim];
         ws.rows = ia.iter().map(|&r| (r - 1) as u32).collect();
         ws.cols = ja.iter().map(|&c| (c - 1) as u32).collect();
-        // Where each nonzero goes (lower triangle of each symmetric dense matrix).
+        // Where each nonzero goes (lower triangle of each symmetric dense matrix),
+        // and which block takes it (its `A`, `C` or `W`; `count`: the border's `S`).
         ws.dest = Vec::with_capacity(ia.len());
+        let mut owners = Vec::with_capacity(ia.len());
         for (&r, &c) in ia.iter().zip(ja) {
             let (r, c) = (r as usize - 1, c as usize - 1);
-            let d = match (block_of[r], block_of[c]) {
+            let (d, owner) = match (block_of[r], block_of[c]) {
                 (usize::MAX, usize::MAX) => {
                     let (i, j) = (local[r].max(local[c]), local[r].min(local[c]));
-                    ws.s_off + i + j * nb
+                    (ws.s_off + i + j * nb, count)
                 }
                 (usize::MAX, b) | (b, usize::MAX) => {
                     let (row, bcol) = if block_of[r] == b {
@@ -403,7 +405,7 @@ impl Workspace {
                     let blk = ws.blocks[b];
                     let cols = &ws.border_cols[blk.b_first..blk.b_first + blk.m];
                     let j = cols.binary_search(&bcol).ok()?;
-                    ws.w_base + blk.w_off + row + j * blk.n
+                    (ws.w_base + blk.w_off + row + j * blk.n, b)
                 }
                 (br, bc) if br != bc => {
                     let (hi, row, prev) = if br > bc {
@@ -414,34 +416,19 @@ impl Workspace {
                     let blk = ws.blocks[hi];
                     let links = &ws.links[blk.l_first..blk.l_first + blk.l];
                     let j = links.binary_search(&prev).ok()?;
-                    ws.c_base + blk.c_off + row + j * blk.n
+                    (ws.c_base + blk.c_off + row + j * blk.n, hi)
                 }
                 (b, _) => {
                     let blk = ws.blocks[b];
                     let (i, j) = (local[r].max(local[c]), local[r].min(local[c]));
-                    blk.a_off + i + j * blk.n
+                    (blk.a_off + i + j * blk.n, b)
                 }
             };
             ws.dest.push(d);
+            owners.push(owner);
         }
         // Group the nonzeros by the block that takes them (the border last), so that each
         // block is assembled just before it is needed, while it is in cache.
-        let owner_of = |d: usize| -> usize {
-            if d >= ws.s_off {
-                return count;
-            }
-            let (base, off): (usize, fn(&Block) -> usize) = if d >= ws.w_base {
-                (ws.w_base, |b| b.w_off)
-            } else if d >= ws.c_base {
-                (ws.c_base, |b| b.c_off)
-            } else {
-                (0, |b| b.a_off)
-            };
-            // The last block whose region starts at or before `d` (regions are in block
-            // order; empty ones share their start with the next block's).
-            ws.blocks.partition_point(|b| base + off(b) <= d) - 1
-        };
-        let owners: Vec<usize> = ws.dest.iter().map(|&d| owner_of(d)).collect();
         ws.owner_start = vec![0; count + 2];
         for &o in &owners {
             ws.owner_start[o + 1] += 1;
@@ -458,8 +445,6 @@ impl Workspace {
         Some(ws)
     }
 
-    /// Factorises the matrix with nonzeros `values`. `None`: a non-finite entry, a pivot
-    /// under `floor` or a zero pivot column; otherwise the number of negative eigenvalues.
     /// Assembles group `owner` (a block's `A`, `C` and `W`, or with `owner` = the block
     /// count the border's `S`) from `values`; `None` on a non-finite entry.
     fn assemble(&mut self, owner: usize, values: &[f64]) -> Option<()> {
@@ -485,6 +470,8 @@ impl Workspace {
         finite.then_some(())
     }
 
+    /// Factorises the matrix with nonzeros `values`. `None`: a non-finite entry, a pivot
+    /// under `floor` or a zero pivot column; otherwise the number of negative eigenvalues.
     fn factor(&mut self, values: &[f64], floor: f64) -> Option<usize> {
         let count = self.blocks.len();
         self.k_max = 0.0;
@@ -521,12 +508,9 @@ impl Workspace {
             // a solve per column (the solves do the other half).
             let g = &mut self.g_w[..n * m];
             g.copy_from_slice(w);
-            bunch_kaufman::forward_many(a, n, piv, g, m);
-            let g = &*g;
             let v = &mut self.y[blk.y_off..blk.y_off + n * m];
-            v.copy_from_slice(g);
-            bunch_kaufman::scale_by_d_inv(a, n, piv, v, m);
-            let v = &*v;
+            half_solve(a, n, piv, g, v, m);
+            let (g, v) = (&*g, &*v);
             // S -= W_kᵀ Ã_kk⁻¹ W_k = Gᵀ V over the lower triangle (border columns increase).
             let cols = &self.border_cols[blk.b_first..blk.b_first + m];
             for (jj, &bj) in cols.iter().enumerate() {
@@ -545,16 +529,13 @@ impl Workspace {
             }
             let links = &self.links[next.l_first..next.l_first + l];
             let gl = &mut self.g_l[..n * l];
-            gl.iter_mut().for_each(|x| *x = 0.0);
+            gl.fill(0.0);
             for (col, &li) in gl.chunks_exact_mut(n).zip(links) {
                 col[li] = 1.0;
             }
-            bunch_kaufman::forward_many(a, n, piv, gl, l);
-            let gl = &*gl;
             let vl = &mut self.z[next.z_off..next.z_off + n * l];
-            vl.copy_from_slice(gl);
-            bunch_kaufman::scale_by_d_inv(a, n, piv, vl, l);
-            let vl = &*vl;
+            half_solve(a, n, piv, gl, vl, l);
+            let (gl, vl) = (&*gl, &*vl);
             let mm = &mut self.m_link[..l * l];
             for (j, vj) in vl.chunks_exact(n).enumerate() {
                 for (i, gi) in gl.chunks_exact(n).enumerate() {
@@ -749,6 +730,14 @@ impl Workspace {
             b[i] = w;
         }
     }
+}
+
+/// With the factors `Ã = P L D Lᵀ Pᵀ` of `a`: `g ← L⁻¹ Pᵀ g` and `v ← D⁻¹ g` for the
+/// `ncols` columns of `g` (then `uᵀ Ã⁻¹ g₀ = (L⁻¹ Pᵀ u)ᵀ v`).
+fn half_solve(a: &[f64], n: usize, piv: &[i32], g: &mut [f64], v: &mut [f64], ncols: usize) {
+    bunch_kaufman::forward_many(a, n, piv, g, ncols);
+    v.copy_from_slice(g);
+    bunch_kaufman::scale_by_d_inv(a, n, piv, v, ncols);
 }
 
 /// Who factored the current matrix.
