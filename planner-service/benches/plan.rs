@@ -53,16 +53,16 @@ fn main() {
     let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
     let settings = PlannerSettings::default();
     println!(
-        "| scenario | median ms | p95 ms | swarm % | NLP % | rest % | cost min | cost max | spread % | peak heap MiB | quality |"
+        "| scenario | median ms | p95 ms | swarm % | NLP % | of it ranking % | rest % | cost min | cost max | spread % | peak heap MiB | quality |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     for (name, _) in BUNDLED {
         if only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
             continue;
         }
         let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
         let mut times = Vec::new();
-        let (mut swarm, mut nlp, mut total) = (0.0, 0.0, 0.0);
+        let (mut swarm, mut nlp, mut ranking, mut total) = (0.0, 0.0, 0.0, 0.0);
         let mut costs = Vec::new();
         let mut qualities = std::collections::BTreeMap::new();
         let base = LIVE.load(Ordering::Relaxed);
@@ -84,6 +84,7 @@ fn main() {
             times.push(t);
             swarm += out.times.swarm.as_secs_f64() * 1e3;
             nlp += out.times.nlp.as_secs_f64() * 1e3;
+            ranking += out.times.ranking.as_secs_f64() * 1e3;
             total += t;
             costs.push(out.cost);
             *qualities.entry(format!("{:?}", out.quality)).or_insert(0) += 1;
@@ -93,11 +94,12 @@ fn main() {
         costs.sort_by(f64::total_cmp);
         let (lo, hi) = (costs[0], costs[costs.len() - 1]);
         println!(
-            "| {name} | {:.1} | {:.1} | {:.0} | {:.0} | {:.0} | {lo:.6} | {hi:.6} | {:.3} | {peak:.1} | {} |",
+            "| {name} | {:.1} | {:.1} | {:.0} | {:.0} | {:.0} | {:.0} | {lo:.6} | {hi:.6} | {:.3} | {peak:.1} | {} |",
             percentile(&times, 0.5),
             percentile(&times, 0.95),
             100.0 * swarm / total,
             100.0 * nlp / total,
+            100.0 * ranking / total,
             100.0 * (total - swarm - nlp) / total,
             100.0 * (hi - lo) / lo.abs().max(1e-12),
             qualities

@@ -5,7 +5,7 @@
 //! `cargo run --release -p wingman-planner --example probe -- [NAME-FILTER] [RUNS]`
 //!
 //! Overrides: `PROBE_STARTS`, `PROBE_FINALISTS`, `PROBE_ROUNDS`, `PROBE_RANK_PTS`,
-//! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`, `PROBE_DEFECT_TOL`
+//! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`, `PROBE_DEFECT_TOL`, `PROBE_DUP_TOL`, `PROBE_GAP_TOL`
 //! (the refinement's tolerance, m),
 //! `PROBE_NLP="name=value;name=value"` (extra solver options; `PROBE_RANK_NLP` and
 //! `PROBE_FINAL_NLP` for the ranking or the working-mesh solves only); `PROBE_FIRST_SEED` (1);
@@ -45,6 +45,12 @@ fn main() {
     }
     if let Some(v) = env("PROBE_FINALISTS") {
         s.finalists = v;
+    }
+    if let Some(v) = env("PROBE_DUP_TOL") {
+        s.finalist_duplicate_tol = v;
+    }
+    if let Some(v) = env("PROBE_GAP_TOL") {
+        s.finalist_gap_tol = v;
     }
     if let Some(v) = env("PROBE_ROUNDS") {
         s.refine_rounds = v;
@@ -184,9 +190,10 @@ fn main() {
             }
             if seed == 1 {
                 line = format!(
-                    "swarm {:.0} nlp {:.0} it {:?} q {:?}",
+                    "swarm {:.0} nlp {:.0} (rank {:.0}) it {:?} q {:?}",
                     out.times.swarm.as_secs_f64() * 1e3,
                     out.times.nlp.as_secs_f64() * 1e3,
+                    out.times.ranking.as_secs_f64() * 1e3,
                     out.nlp.iterations,
                     out.quality
                 );

@@ -73,8 +73,17 @@ pub struct PlannerSettings {
     pub ranking_mu_init_3d: Option<f64>,
     /// Largest scaled constraint violation of a ranking solve that still ranks.
     pub ranking_feasibility_tol: f64,
-    /// How many of the best-ranked starts are solved again on the working mesh.
+    /// How many of the best-ranked starts are solved again on the working mesh (at most).
     pub finalists: usize,
+    /// A ranked start whose dense cost is within this of a finalist's (relative) reached
+    /// the same basin: it is not solved again.
+    pub finalist_duplicate_tol: f64,
+    /// ... and whose path stays within this distance of it (m, at the same fraction of
+    /// the durations).
+    pub finalist_duplicate_m: f64,
+    /// A ranked start whose dense cost is above the best's by more than this (relative)
+    /// is out of the race: it is not solved again.
+    pub finalist_gap_tol: f64,
     /// Start the solves on the working and the refined meshes primal-dual from the
     /// previous mesh's solution (multipliers carried over, see `collocation::warm`).
     pub warm_mesh_changes: bool,
@@ -143,6 +152,9 @@ impl Default for PlannerSettings {
             ranking_mu_init_3d: Some(1e-3),
             ranking_feasibility_tol: 1e-4,
             finalists: 2,
+            finalist_duplicate_tol: 1e-3,
+            finalist_duplicate_m: 2000.0,
+            finalist_gap_tol: 0.1,
             warm_mesh_changes: true,
         }
     }
@@ -166,6 +178,8 @@ pub enum PlanError {
 pub struct StageTimes {
     pub swarm: Duration,
     pub nlp: Duration,
+    /// The part of `nlp` spent ranking the starts on the coarse mesh.
+    pub ranking: Duration,
     pub export: Duration,
     pub total: Duration,
 }
@@ -454,6 +468,7 @@ impl Planner {
                 deadline,
             )
         });
+        times.ranking = clock.now().saturating_sub(nlp_started);
         let mut order: Vec<(f64, usize, Trajectory)> = Vec::new();
         let reference = ExportSettings {
             closed_loop: false,
@@ -482,7 +497,7 @@ impl Planner {
         }
         // Lowest objective first; ties go to the earlier start (deterministic).
         order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        order.truncate(settings.finalists.max(1));
+        let mut order = finalists(problem.dim(), order, settings);
         if order.is_empty() {
             // No start ranked (e.g. no time): try the swarm's best on the working mesh.
             order.push((f64::INFINITY, 0, sw.best.clone()));
@@ -615,6 +630,63 @@ impl Planner {
     }
 }
 
+/// The ranked starts (lowest dense cost first; positions in the first `dims` state
+/// components) that go on to the working mesh: the best,
+/// then up to `finalists - 1` more that are neither a duplicate of one already taken (a
+/// ranked cost within `finalist_duplicate_tol` of it, relative: the same basin reached
+/// twice) nor out of the race (above the best by more than `finalist_gap_tol`).
+fn finalists(
+    dims: usize,
+    ranked: Vec<(f64, usize, Trajectory)>,
+    settings: &PlannerSettings,
+) -> Vec<(f64, usize, Trajectory)> {
+    let mut taken: Vec<(f64, usize, Trajectory)> = Vec::with_capacity(settings.finalists);
+    for r in ranked {
+        let Some(best) = taken.first().map(|t| t.0) else {
+            taken.push(r);
+            continue;
+        };
+        if taken.len() >= settings.finalists.max(1)
+            || r.0 > best + settings.finalist_gap_tol * best.abs()
+        {
+            break;
+        }
+        let duplicate = taken.iter().any(|t| {
+            (r.0 - t.0).abs() <= settings.finalist_duplicate_tol * t.0.abs()
+                && path_distance(&r.2, &t.2, dims) <= settings.finalist_duplicate_m
+        });
+
+        if !duplicate {
+            taken.push(r);
+        }
+    }
+    taken
+}
+
+/// Largest distance between the positions (the first `dims` state components) of two paths at the same fraction of their
+/// durations (`SAMPLES` + 1 points); infinite if either is empty.
+fn path_distance(a: &Trajectory, b: &Trajectory, dims: usize) -> f64 {
+    const SAMPLES: usize = 200;
+    let span = |t: &Trajectory| Some((*t.times.first()?, t.final_time()?));
+    let (Some((a0, a1)), Some((b0, b1))) = (span(a), span(b)) else {
+        return f64::INFINITY;
+    };
+    let mut worst = 0.0f64;
+    for k in 0..=SAMPLES {
+        let f = k as f64 / SAMPLES as f64;
+        let (Some((xa, _)), Some((xb, _))) = (a.at(a0 + f * (a1 - a0)), b.at(b0 + f * (b1 - b0)))
+        else {
+            return f64::INFINITY;
+        };
+        let d = (0..dims)
+            .map(|i| (xa[i] - xb[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        worst = worst.max(d);
+    }
+    worst
+}
+
 /// The transcription and primal-dual solution of `solved` to warm-start the next mesh from.
 fn warm_start_of(solved: &Option<Solved>, enabled: bool) -> Option<(&Transcription, &PrimalDual)> {
     let s = solved.as_ref().filter(|_| enabled)?;
@@ -663,5 +735,69 @@ pub fn trajectory_cost(problem: &Problem, tr: &Trajectory) -> f64 {
     match problem.objective {
         Objective::FixedTime => run,
         _ => w.alpha * tr.times[n - 1] + (1.0 - w.alpha) * run,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A straight 2-D path from `(0, y)` east at 200 m/s for 100 s.
+    fn line(y: f64) -> Trajectory {
+        let mut tr = Trajectory::default();
+        for k in 0..=10 {
+            let t = 10.0 * k as f64;
+            tr.push(t, [200.0 * t, y, 0.0, 0.0, 0.0, 0.0, 0.0], [0.0; 2]);
+        }
+        tr.phase_ends = vec![100.0];
+        tr
+    }
+
+    #[test]
+    fn path_distance_is_the_largest_gap_at_equal_fractions_of_the_durations() {
+        // Exact: parallel lines 300 m apart; the heading (index 2) is not a position.
+        assert_eq!(path_distance(&line(0.0), &line(300.0), 2), 300.0);
+        let mut turned = line(0.0);
+        turned.states[10][2] = 1.0;
+        assert_eq!(path_distance(&line(0.0), &turned, 2), 0.0);
+        // The same path flown slower (twice the duration) is the same path.
+        let mut slow = line(0.0);
+        slow.times.iter_mut().for_each(|t| *t *= 2.0);
+        assert!(path_distance(&line(0.0), &slow, 2) < 1e-9);
+        assert_eq!(
+            path_distance(&line(0.0), &Trajectory::default(), 2),
+            f64::INFINITY
+        );
+    }
+
+    #[test]
+    fn finalists_skip_duplicates_and_starts_out_of_the_race() {
+        let settings = PlannerSettings::default();
+        let ranked = |entries: &[(f64, f64)]| -> Vec<(f64, usize, Trajectory)> {
+            entries
+                .iter()
+                .enumerate()
+                .map(|(i, &(cost, y))| (cost, i, line(y)))
+                .collect()
+        };
+        let picked = |entries: &[(f64, f64)]| -> Vec<usize> {
+            finalists(2, ranked(entries), &settings)
+                .iter()
+                .map(|f| f.1)
+                .collect()
+        };
+        // A close cost on a path 100 m away is the same basin: the next distinct one goes.
+        assert_eq!(picked(&[(10.0, 0.0), (10.005, 100.0), (10.2, 9e3)]), [0, 2]);
+        // A close cost on a path 9 km away is another basin (2d-min-time-unavoidable,
+        // seeds 17-18: 0.07 % apart, 43 km apart, and the second won on the working mesh).
+        assert_eq!(picked(&[(10.0, 0.0), (10.007, 9e3), (10.2, 1e3)]), [0, 1]);
+        // More than 10 % above the best: out of the race, and so is everything after it.
+        assert_eq!(picked(&[(10.0, 0.0), (11.5, 9e3), (11.6, -9e3)]), [0]);
+        // At most `finalists`.
+        assert_eq!(
+            picked(&[(10.0, 0.0), (10.1, 9e3), (10.2, -9e3), (10.3, 2e4)]),
+            [0, 1]
+        );
+        assert!(finalists(2, Vec::new(), &settings).is_empty());
     }
 }
