@@ -635,11 +635,12 @@ impl Planner {
     }
 }
 
-/// The ranked starts (lowest dense cost first; positions in the first `dims` state
-/// components) that go on to the working mesh: the best,
+/// The ranked starts (lowest dense cost first) that go on to the working mesh: the best,
 /// then up to `finalists - 1` more that are neither a duplicate of one already taken (a
-/// ranked cost within `finalist_duplicate_tol` of it, relative: the same basin reached
-/// twice) nor out of the race (above the best by more than `finalist_gap_tol`).
+/// ranked cost within `finalist_duplicate_tol` of it, relative, on a path within
+/// `finalist_duplicate_m` of it: the same basin reached twice) nor out of the race (above
+/// the best by more than `finalist_gap_tol`). Positions are the first `dims` state
+/// components.
 fn finalists(
     dims: usize,
     ranked: Vec<(f64, usize, Trajectory)>,
@@ -660,7 +661,6 @@ fn finalists(
             (r.0 - t.0).abs() <= settings.finalist_duplicate_tol * t.0.abs()
                 && path_distance(&r.2, &t.2, dims) <= settings.finalist_duplicate_m
         });
-
         if !duplicate {
             taken.push(r);
         }
@@ -668,8 +668,9 @@ fn finalists(
     taken
 }
 
-/// Largest distance between the positions (the first `dims` state components) of two paths at the same fraction of their
-/// durations (`SAMPLES` + 1 points); infinite if either is empty.
+/// Largest distance between the positions (the first `dims` state components) of two
+/// paths at the same fraction of their durations (`SAMPLES` + 1 points); infinite if
+/// either is empty.
 fn path_distance(a: &Trajectory, b: &Trajectory, dims: usize) -> f64 {
     const SAMPLES: usize = 200;
     let span = |t: &Trajectory| Some((*t.times.first()?, t.final_time()?));
