@@ -5,8 +5,9 @@
 //! `cargo run --release -p wingman-planner --example probe -- [NAME-FILTER] [RUNS]`
 //!
 //! Overrides: `PROBE_STARTS`, `PROBE_FINALISTS`, `PROBE_ROUNDS`, `PROBE_RANK_PTS`,
-//! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`, `PROBE_DEFECT_TOL`, `PROBE_DUP_TOL`, `PROBE_GAP_TOL`
-//! (the refinement's tolerance, m),
+//! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`, `PROBE_DEFECT_TOL`
+//! (the refinement's tolerance, m), `PROBE_DUP_TOL` and `PROBE_GAP_TOL` (the finalists'
+//! duplicate and gap tolerances),
 //! `PROBE_NLP="name=value;name=value"` (extra solver options; `PROBE_RANK_NLP` and
 //! `PROBE_FINAL_NLP` for the ranking or the working-mesh solves only); `PROBE_FIRST_SEED` (1);
 //! `PROBE_KKT=feral|structured` (the KKT linear solver of every NLP solve);

@@ -206,18 +206,6 @@ pub fn candidates(
         if out.len() >= count {
             break;
         }
-        let separation = |a: &Trajectory, b: &Trajectory| -> f64 {
-            let n = 32;
-            (0..n)
-                .map(|k| {
-                    let f = (k as f64 + 0.5) / n as f64;
-                    let pa = &a.states[((a.len() - 1) as f64 * f) as usize];
-                    let pb = &b.states[((b.len() - 1) as f64 * f) as usize];
-                    (pa[0] - pb[0]).hypot(pa[1] - pb[1])
-                })
-                .sum::<f64>()
-                / n as f64
-        };
         if out.iter().all(|o| separation(o, &tr) > MIN_SEPARATION_M) {
             out.push(tr);
         }
@@ -225,5 +213,24 @@ pub fn candidates(
     out
 }
 
-/// Mean horizontal distance that makes a same-class seed a distinct start.
-const MIN_SEPARATION_M: f64 = 3000.0;
+/// Mean horizontal distance that makes two paths of one class distinct starts (or two
+/// ranked solutions distinct finalists).
+pub const MIN_SEPARATION_M: f64 = 3000.0;
+
+/// Mean horizontal distance between two paths at the same fractions of their samples (32
+/// points); infinite if either is empty.
+pub fn separation(a: &Trajectory, b: &Trajectory) -> f64 {
+    if a.is_empty() || b.is_empty() {
+        return f64::INFINITY;
+    }
+    let n = 32;
+    (0..n)
+        .map(|k| {
+            let f = (k as f64 + 0.5) / n as f64;
+            let pa = &a.states[((a.len() - 1) as f64 * f) as usize];
+            let pb = &b.states[((b.len() - 1) as f64 * f) as usize];
+            (pa[0] - pb[0]).hypot(pa[1] - pb[1])
+        })
+        .sum::<f64>()
+        / n as f64
+}

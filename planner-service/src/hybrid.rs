@@ -75,12 +75,10 @@ pub struct PlannerSettings {
     pub ranking_feasibility_tol: f64,
     /// How many of the best-ranked starts are solved again on the working mesh (at most).
     pub finalists: usize,
-    /// A ranked start whose dense cost is within this of a finalist's (relative) reached
-    /// the same basin: it is not solved again.
+    /// A ranked start whose dense cost is within this of a finalist's (relative), on a path
+    /// not distinct from it ([`basins::separation`] under [`basins::MIN_SEPARATION_M`]),
+    /// reached the same basin: it is not solved again.
     pub finalist_duplicate_tol: f64,
-    /// ... and whose path stays within this distance of it (m, at the same fraction of
-    /// the durations).
-    pub finalist_duplicate_m: f64,
     /// A ranked start whose dense cost is above the best's by more than this (relative)
     /// is out of the race: it is not solved again.
     pub finalist_gap_tol: f64,
@@ -158,7 +156,6 @@ impl Default for PlannerSettings {
             ranking_feasibility_tol: 1e-4,
             finalists: 2,
             finalist_duplicate_tol: 1e-3,
-            finalist_duplicate_m: 2000.0,
             finalist_gap_tol: 0.1,
             warm_mesh_changes: true,
         }
@@ -502,7 +499,7 @@ impl Planner {
         }
         // Lowest objective first; ties go to the earlier start (deterministic).
         order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let mut order = finalists(problem.dim(), order, settings);
+        let mut order = finalists(order, settings);
         if order.is_empty() {
             // No start ranked (e.g. no time): try the swarm's best on the working mesh.
             order.push((f64::INFINITY, 0, sw.best.clone()));
@@ -637,12 +634,10 @@ impl Planner {
 
 /// The ranked starts (lowest dense cost first) that go on to the working mesh: the best,
 /// then up to `finalists - 1` more that are neither a duplicate of one already taken (a
-/// ranked cost within `finalist_duplicate_tol` of it, relative, on a path within
-/// `finalist_duplicate_m` of it: the same basin reached twice) nor out of the race (above
-/// the best by more than `finalist_gap_tol`). Positions are the first `dims` state
-/// components.
+/// ranked cost within `finalist_duplicate_tol` of it, relative, on a path not distinct
+/// from it: the same basin reached twice) nor out of the race (above the best by more
+/// than `finalist_gap_tol`).
 fn finalists(
-    dims: usize,
     ranked: Vec<(f64, usize, Trajectory)>,
     settings: &PlannerSettings,
 ) -> Vec<(f64, usize, Trajectory)> {
@@ -659,38 +654,13 @@ fn finalists(
         }
         let duplicate = taken.iter().any(|t| {
             (r.0 - t.0).abs() <= settings.finalist_duplicate_tol * t.0.abs()
-                && path_distance(&r.2, &t.2, dims) <= settings.finalist_duplicate_m
+                && basins::separation(&r.2, &t.2) <= basins::MIN_SEPARATION_M
         });
         if !duplicate {
             taken.push(r);
         }
     }
     taken
-}
-
-/// Largest distance between the positions (the first `dims` state components) of two
-/// paths at the same fraction of their durations (`SAMPLES` + 1 points); infinite if
-/// either is empty.
-fn path_distance(a: &Trajectory, b: &Trajectory, dims: usize) -> f64 {
-    const SAMPLES: usize = 200;
-    let span = |t: &Trajectory| Some((*t.times.first()?, t.final_time()?));
-    let (Some((a0, a1)), Some((b0, b1))) = (span(a), span(b)) else {
-        return f64::INFINITY;
-    };
-    let mut worst = 0.0f64;
-    for k in 0..=SAMPLES {
-        let f = k as f64 / SAMPLES as f64;
-        let (Some((xa, _)), Some((xb, _))) = (a.at(a0 + f * (a1 - a0)), b.at(b0 + f * (b1 - b0)))
-        else {
-            return f64::INFINITY;
-        };
-        let d = (0..dims)
-            .map(|i| (xa[i] - xb[i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        worst = worst.max(d);
-    }
-    worst
 }
 
 /// The transcription and primal-dual solution of `solved` to warm-start the next mesh from.
@@ -760,18 +730,18 @@ mod tests {
     }
 
     #[test]
-    fn path_distance_is_the_largest_gap_at_equal_fractions_of_the_durations() {
+    fn separation_is_the_mean_horizontal_gap_at_equal_fractions_of_the_paths() {
         // Exact: parallel lines 300 m apart; the heading (index 2) is not a position.
-        assert_eq!(path_distance(&line(0.0), &line(300.0), 2), 300.0);
+        assert_eq!(basins::separation(&line(0.0), &line(300.0)), 300.0);
         let mut turned = line(0.0);
         turned.states[10][2] = 1.0;
-        assert_eq!(path_distance(&line(0.0), &turned, 2), 0.0);
+        assert_eq!(basins::separation(&line(0.0), &turned), 0.0);
         // The same path flown slower (twice the duration) is the same path.
         let mut slow = line(0.0);
         slow.times.iter_mut().for_each(|t| *t *= 2.0);
-        assert!(path_distance(&line(0.0), &slow, 2) < 1e-9);
+        assert!(basins::separation(&line(0.0), &slow) < 1e-9);
         assert_eq!(
-            path_distance(&line(0.0), &Trajectory::default(), 2),
+            basins::separation(&line(0.0), &Trajectory::default()),
             f64::INFINITY
         );
     }
@@ -787,7 +757,7 @@ mod tests {
                 .collect()
         };
         let picked = |entries: &[(f64, f64)]| -> Vec<usize> {
-            finalists(2, ranked(entries), &settings)
+            finalists(ranked(entries), &settings)
                 .iter()
                 .map(|f| f.1)
                 .collect()
@@ -804,6 +774,6 @@ mod tests {
             picked(&[(10.0, 0.0), (10.1, 9e3), (10.2, -9e3), (10.3, 2e4)]),
             [0, 1]
         );
-        assert!(finalists(2, Vec::new(), &settings).is_empty());
+        assert!(finalists(Vec::new(), &settings).is_empty());
     }
 }
