@@ -9,7 +9,9 @@
 //! (the refinement's tolerance, m), `PROBE_DUP_TOL` and `PROBE_GAP_TOL` (the finalists'
 //! duplicate and gap tolerances),
 //! `PROBE_NLP="name=value;name=value"` (extra solver options; `PROBE_RANK_NLP` and
-//! `PROBE_FINAL_NLP` for the ranking or the working-mesh solves only); `PROBE_FIRST_SEED` (1);
+//! `PROBE_FINAL_NLP` for the ranking or the working-mesh solves only, `PROBE_FIN_NLP` for the
+//! finalists' only); `PROBE_FIN_TOL`, `PROBE_FIN_ACC`, `PROBE_FIN_SOC=0|1` (the finalists'
+//! tolerance, acceptable tolerance, second-order check); `PROBE_FIRST_SEED` (1);
 //! `PROBE_KKT=feral|structured` (the KKT linear solver of every NLP solve);
 //! `PROBE_ITS=1` prints every plan's NLP iterations per solve (deterministic, unlike times);
 //! `PROBE_OUT=DIR` writes
@@ -81,9 +83,11 @@ fn main() {
     }
     if let Some(v) = env("PROBE_WARM_MU") {
         s.nlp.warm_start_mu_init = v;
+        s.finalist_nlp.warm_start_mu_init = v;
     }
     if let Some(v) = env("PROBE_WARM_PUSH") {
         s.nlp.warm_start_push = v;
+        s.finalist_nlp.warm_start_push = v;
     }
     if let Ok(v) = std::env::var("PROBE_KKT") {
         let kkt = match v.as_str() {
@@ -92,12 +96,14 @@ fn main() {
             other => panic!("PROBE_KKT={other}: feral or structured"),
         };
         s.nlp.kkt = kkt;
+        s.finalist_nlp.kkt = kkt;
         s.ranking_nlp.kkt = kkt;
     }
     if let Ok(extra) = std::env::var("PROBE_NLP") {
         for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
             if let Some((k, v)) = kv.split_once('=') {
                 s.nlp.extra.push((k.to_string(), v.to_string()));
+                s.finalist_nlp.extra.push((k.to_string(), v.to_string()));
                 s.ranking_nlp.extra.push((k.to_string(), v.to_string()));
             }
         }
@@ -106,8 +112,25 @@ fn main() {
         for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
             if let Some((k, v)) = kv.split_once('=') {
                 s.nlp.extra.push((k.to_string(), v.to_string()));
+                s.finalist_nlp.extra.push((k.to_string(), v.to_string()));
             }
         }
+    }
+    if let Ok(extra) = std::env::var("PROBE_FIN_NLP") {
+        for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
+            if let Some((k, v)) = kv.split_once('=') {
+                s.finalist_nlp.extra.push((k.to_string(), v.to_string()));
+            }
+        }
+    }
+    if let Some(v) = env("PROBE_FIN_TOL") {
+        s.finalist_nlp.tol = v;
+    }
+    if let Some(v) = env("PROBE_FIN_ACC") {
+        s.finalist_nlp.acceptable_tol = v;
+    }
+    if let Some(v) = env::<u8>("PROBE_FIN_SOC") {
+        s.finalist_nlp.second_order_check = v != 0;
     }
     if let Ok(extra) = std::env::var("PROBE_RANK_NLP") {
         for kv in extra.split(';').filter(|kv| !kv.is_empty()) {

@@ -54,6 +54,8 @@ pub struct PlannerSettings {
     /// The NLP settings of the ranking solves on the coarse mesh (they only have to tell
     /// the basins apart: looser tolerances).
     pub ranking_nlp: NlpSettings,
+    /// The NLP settings of the finalists' solves on the working mesh.
+    pub finalist_nlp: NlpSettings,
     pub refine: RefineSettings,
     /// Refinement rounds after the first NLP solve.
     pub refine_rounds: usize,
@@ -113,6 +115,17 @@ impl Default for PlannerSettings {
                 // (3 ms per 2-D, 8-10 ms per 3-D ranking solve; the same iterations and
                 // plans on the canonical scenarios, seeds 1-3, judged).
                 second_order_check: false,
+                ..NlpSettings::default()
+            },
+            // Looser than the working tolerance: a refined solve (or a polish on the same
+            // mesh) follows. The violation stays below `nlp.feasibility_tol`, so a finalist
+            // is accepted as the refined ones are.
+            finalist_nlp: NlpSettings {
+                feral_static_pivoting: true,
+                tol: 1e-5,
+                acceptable_tol: 1e-4,
+                acceptable_constr_viol_tol: Some(1e-7),
+                constr_viol_tol: Some(1e-7),
                 ..NlpSettings::default()
             },
             refine: RefineSettings::default(),
@@ -255,6 +268,9 @@ struct MeshSolve<'a> {
     min_time: Duration,
     /// The first barrier parameter, over `nlp_settings`' (`None`: theirs).
     mu_init: Option<f64>,
+    /// The primal starting point itself (scaled), when it is a solution on this very mesh
+    /// (`guess` then only sets the bounds).
+    start_x: Option<&'a [f64]>,
 }
 
 /// Solves `job.problem` on `job.mesh` from `job.guess`; `None` if the result is not
@@ -271,6 +287,7 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
         warm_from,
         min_time,
         mu_init,
+        start_x,
     } = job;
     if deadline.remaining() <= min_time {
         // No time for even one iteration (the longest set-up and first iteration of the
@@ -279,7 +296,14 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
     }
     let mut tr = Transcription::new(problem, mesh, guess, &settings.transcription);
     let mut x = vec![0.0; tr.n_vars()];
-    tr.initial_point(guess, &mut x);
+    match start_x {
+        Some(x0) if x0.len() == x.len() => {
+            for (i, v) in x.iter_mut().enumerate() {
+                *v = x0[i].clamp(tr.x_lo[i], tr.x_hi[i]);
+            }
+        }
+        _ => tr.initial_point(guess, &mut x),
+    }
     let j0 = tr.objective(&x);
     tr.obj_scale = 1.0 / j0.abs().max(1e-3);
     let mut nlp = nlp_settings.clone();
@@ -466,6 +490,7 @@ impl Planner {
                     } else {
                         None
                     },
+                    start_x: None,
                 },
                 deadline,
             )
@@ -524,7 +549,7 @@ impl Planner {
                     mesh: &fine[i],
                     guess: &order[i].2,
                     settings,
-                    nlp_settings: &settings.nlp,
+                    nlp_settings: &settings.finalist_nlp,
                     refined: true,
                     feasibility_tol: settings.nlp.feasibility_tol,
                     warm_from: coarse_solved
@@ -532,6 +557,7 @@ impl Planner {
                         .and_then(|s| warm_start_of(s, warm)),
                     min_time,
                     mu_init: None,
+                    start_x: None,
                 },
                 deadline,
             )
@@ -552,7 +578,11 @@ impl Planner {
             }
         }
         let mut guess = Trajectory::default();
-        for _ in 0..settings.refine_rounds {
+        // The finalists may stop at a looser tolerance than the working one, as a refined
+        // solve follows; when the mesh needs no refinement, the accepted finalist is
+        // solved again on its own mesh, from its own solution ("polished").
+        let mut polish = settings.finalist_nlp.tol > settings.nlp.tol;
+        for round in 0..settings.refine_rounds.max(usize::from(polish)) {
             let Some(current) = accepted.as_ref() else {
                 break;
             };
@@ -561,9 +591,17 @@ impl Planner {
             }
             let mut errors = Vec::new();
             interval_errors(&current.tr, &current.x, &mut errors);
-            let Some(next) = refine(&mesh, &errors, &settings.refine) else {
-                break;
+            let refined = if round < settings.refine_rounds {
+                refine(&mesh, &errors, &settings.refine)
+            } else {
+                None
             };
+            let (next, same) = match refined {
+                Some(next) => (next, false),
+                None if polish => (mesh.clone(), true),
+                None => break,
+            };
+            polish = false;
             export(&current.tr, &current.x, &reference, &mut guess);
             let (solved, iterations, status, _) = solve_on_mesh(
                 MeshSolve {
@@ -577,6 +615,7 @@ impl Planner {
                     warm_from: warm_start_of(&accepted, warm),
                     min_time,
                     mu_init: None,
+                    start_x: same.then_some(current.x.as_slice()),
                 },
                 deadline,
             )?;

@@ -35,6 +35,9 @@ pub struct NlpSettings {
     /// Largest constraint violation an "acceptable" stop may leave (`None`: the solver's
     /// default, 1e-2).
     pub acceptable_constr_viol_tol: Option<f64>,
+    /// Largest constraint violation a converged solve may leave (Ipopt `constr_viol_tol`,
+    /// on the scaled problem; `None`: the solver's default, 1e-4).
+    pub constr_viol_tol: Option<f64>,
     /// Iteration limit.
     pub max_iter: i32,
     /// Largest scaled constraint violation of an iterate that counts as feasible.
@@ -87,6 +90,7 @@ impl Default for NlpSettings {
             acceptable_tol: 1e-5,
             acceptable_iter: 5,
             acceptable_constr_viol_tol: None,
+            constr_viol_tol: None,
             max_iter: 300,
             feasibility_tol: 1e-6,
             mu_strategy: "monotone",
@@ -367,6 +371,9 @@ fn application(
     num(o, "acceptable_tol", settings.acceptable_tol)?;
     if let Some(v) = settings.acceptable_constr_viol_tol {
         num(o, "acceptable_constr_viol_tol", v)?;
+    }
+    if let Some(v) = settings.constr_viol_tol {
+        num(o, "constr_viol_tol", v)?;
     }
     num(o, "max_wall_time", budget.as_secs_f64().max(1e-3))?;
     let int = |o: &mut OptionsList, name: &'static str, v: i32| {
