@@ -240,8 +240,9 @@ fn main() {
     }
     println!("worst cost/ref {worst:.5}");
     println!(
-        "KKT factorisations: {} by block elimination, {} handed to FERAL",
+        "KKT factorisations: {} by block elimination ({} without pivot groups), {} handed to FERAL",
         wingman_planner::collocation::kkt::block_factorizations_total(),
+        wingman_planner::collocation::kkt::plain_factorizations_total(),
         wingman_planner::collocation::kkt::feral_fallbacks_total()
     );
 }

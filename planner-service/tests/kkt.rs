@@ -100,7 +100,7 @@ fn labels_fit_and_do_not_allocate(name: &str) {
     let mesh = Mesh::uniform(5, &phase_durations(p.t0, &guess), 35.0, 2);
     let tr = Transcription::new(&p, &mesh, &guess, &TranscriptionSettings::default());
     let labels = KktLabels::of(&tr);
-    let border = labels.0.iter().filter(|&&l| l < 0).count();
+    let border = labels.blocks.iter().filter(|&&l| l < 0).count();
     let phases = mesh.phases.len();
     assert!(
         border <= 3 * phases + 3,
@@ -199,4 +199,59 @@ fn factorise_and_solve_do_not_allocate_2d() {
 #[test]
 fn factorise_and_solve_do_not_allocate_3d() {
     labels_fit_and_do_not_allocate("3d-min-time-rendezvous-unavoidable");
+}
+
+/// The pivot groups of a real transcription: one per collocation node, each its controls
+/// and the defect rows of the states they drive (`2 · nu` KKT indices); and the model's
+/// controls drive exactly those states (`df_c/du_e` is zero for every other state and
+/// nonzero for the driven one, at random states and controls).
+fn groups_are_the_nodes_controls_and_driven_rows(name: &str) {
+    use rand::{RngExt, SeedableRng};
+    let (p, guess) = planned(name);
+    let mesh = Mesh::uniform(5, &phase_durations(p.t0, &guess), 35.0, 2);
+    let (tr, _) = transcribed(&p, &mesh, &guess);
+    let labels = KktLabels::of(&tr);
+    assert_eq!(labels.groups.len(), labels.blocks.len());
+    let mut sizes = std::collections::BTreeMap::new();
+    for (&g, &b) in labels.groups.iter().zip(&labels.blocks) {
+        if g >= 0 {
+            let entry = sizes.entry(g).or_insert((0, b));
+            entry.0 += 1;
+            assert_eq!(entry.1, b, "a group lies inside one block");
+        }
+    }
+    assert_eq!(sizes.len(), tr.layout.control_nodes());
+    assert!(sizes.values().all(|&(n, _)| n == 2 * tr.nu));
+    let driven = tr.vehicle.driven_states();
+    assert_eq!(driven.len(), tr.nu);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    for _ in 0..50 {
+        let x: [f64; 7] = std::array::from_fn(|c| match c {
+            3 => rng.random_range(-0.3..0.3),
+            5 => rng.random_range(0.5..2.5),
+            6 => rng.random_range(-1.0..1.0),
+            _ => rng.random_range(-5.0..5.0),
+        });
+        let u: [f64; 2] = std::array::from_fn(|_| rng.random_range(-0.1..0.1));
+        let d = tr.vehicle.eval(&x, &u);
+        for (e, &drives) in driven.iter().enumerate() {
+            for c in 0..tr.nx {
+                if c == drives {
+                    assert!(d.ju[c][e] != 0.0, "control {e} drives state {c}");
+                } else {
+                    assert_eq!(d.ju[c][e], 0.0, "control {e} does not drive state {c}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn pivot_groups_2d() {
+    groups_are_the_nodes_controls_and_driven_rows("2d-min-time-rendezvous-avoidable");
+}
+
+#[test]
+fn pivot_groups_3d() {
+    groups_are_the_nodes_controls_and_driven_rows("3d-min-time-rendezvous-unavoidable");
 }

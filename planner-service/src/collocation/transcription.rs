@@ -79,6 +79,16 @@ pub struct NodeDynamics {
 }
 
 impl Vehicle {
+    /// The states whose rates the controls drive, one per control (`f_c` of any other
+    /// state does not depend on the controls): `psi` in 2-D, `Nz` and `mu` in 3-D.
+    pub fn driven_states(&self) -> &'static [usize] {
+        use crate::dynamics::{idx2, idx3};
+        match self {
+            Vehicle::Planar(_) => &[idx2::PSI],
+            Vehicle::Spatial(_) => &[idx3::NZ, idx3::MU],
+        }
+    }
+
     pub fn new(problem: &Problem) -> Vehicle {
         // The limits were checked when the problem was built, so the speed is positive.
         let v = problem.limits.speed;
