@@ -1,7 +1,8 @@
 //! The dense Bunch–Kaufman kernels of the structured KKT backend on blocks shaped like the
 //! LGR collocation's (a primal part with 9×9 node blocks, defect rows 30 % dense, a small
 //! negative dual diagonal): 42 rows (a 2-D block), 64 and 96 (3-D ranking and working
-//! meshes). Blocked (`dsytrf`-style panels) against unblocked, each on the dispatched
+//! meshes), and with the pivot groups out of the blocks 25 and 30 (2-D ranking and
+//! working), 48 and 72 (3-D). Blocked (`dsytrf`-style panels) against unblocked, each on the dispatched
 //! (AVX2 where present) and the baseline SSE2 path; and one single-column solve.
 //!
 //! `cargo bench -p wingman-planner --bench kkt`
@@ -40,7 +41,15 @@ fn kkt_block(nx: usize, m: usize, seed: u64) -> Vec<f64> {
 
 fn factor(c: &mut Criterion) {
     let mut g = c.benchmark_group("bunch_kaufman");
-    for (nx, m) in [(24, 18), (36, 28), (52, 44)] {
+    for (nx, m) in [
+        (24, 18),
+        (36, 28),
+        (52, 44),
+        (15, 10),
+        (18, 12),
+        (28, 20),
+        (42, 30),
+    ] {
         let n = nx + m;
         let k = kkt_block(nx, m, n as u64);
         let mut a = k.clone();

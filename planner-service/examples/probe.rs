@@ -4,7 +4,7 @@
 //!
 //! `cargo run --release -p wingman-planner --example probe -- [NAME-FILTER] [RUNS]`
 //!
-//! Overrides: `PROBE_STARTS`, `PROBE_FINALISTS`, `PROBE_ROUNDS`, `PROBE_RANK_PTS`,
+//! Overrides: `PROBE_SW_ITERS`, `PROBE_SW_STALL`, `PROBE_SW_PARTICLES` (the swarm's), `PROBE_STARTS`, `PROBE_FINALISTS`, `PROBE_ROUNDS`, `PROBE_RANK_PTS`,
 //! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`, `PROBE_DEFECT_TOL`
 //! (the refinement's tolerance, m), `PROBE_DUP_TOL` and `PROBE_GAP_TOL` (the finalists'
 //! duplicate and gap tolerances),
@@ -43,6 +43,15 @@ fn main() {
     .unwrap_or_default();
     let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
     let mut s = PlannerSettings::default();
+    if let Some(v) = env("PROBE_SW_ITERS") {
+        s.swarm.max_iterations = v;
+    }
+    if let Some(v) = env("PROBE_SW_STALL") {
+        s.swarm.stall_iterations = v;
+    }
+    if let Some(v) = env("PROBE_SW_PARTICLES") {
+        s.swarm.particles = v;
+    }
     if let Some(v) = env("PROBE_STARTS") {
         s.starts = v;
     }
@@ -211,6 +220,21 @@ fn main() {
             if std::env::var("PROBE_ITS").is_ok() {
                 // One line per plan: `ITS name seed ratio [iterations per solve]`.
                 println!("ITS {name} {seed} {ratio:.5} {:?}", out.nlp.iterations);
+                if std::env::var("PROBE_RANKED").is_ok() {
+                    let best = out
+                        .nlp
+                        .ranking
+                        .iter()
+                        .copied()
+                        .fold(f64::INFINITY, f64::min);
+                    let rel: Vec<String> = out
+                        .nlp
+                        .ranking
+                        .iter()
+                        .map(|c| format!("{:.3}", c / best))
+                        .collect();
+                    println!("RANKED {name} {seed} [{}]", rel.join(", "));
+                }
             }
             if seed == 1 {
                 line = format!(

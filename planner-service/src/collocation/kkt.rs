@@ -734,16 +734,37 @@ impl Workspace {
             let bm = &mut self.g_b[..q * nn];
             bm.copy_from_slice(&self.dense[g.g_off + q * q..g.g_off + q * q + q * nn]);
             let gm = &mut self.dense[g.g_off..g.g_off + q * q];
-            let piv = &mut self.g_piv[g.first..g.first + q];
-            negative += factor_above(&mut *gm, q, piv, &mut self.bk_work, floor)?;
-            let (gm, piv) = (&*gm, &*piv);
             // G⁻¹ explicitly (the solves apply it), then Y = G⁻¹ B.
             let inv = &mut self.g_inv[g.inv_off..g.inv_off + q * q];
-            inv.fill(0.0);
-            for k in 0..q {
-                inv[k * q + k] = 1.0;
+            if q == 2 {
+                // In closed form: the inertia from the determinant, the smallest pivot the
+                // smallest eigenvalue magnitude.
+                let (a, b, c) = (gm[0], gm[1], gm[3]);
+                let det = a * c - b * b;
+                let r = (0.5 * (a - c)).hypot(b);
+                let mean = 0.5 * (a + c);
+                let min_pivot = (mean - r).abs().min((mean + r).abs());
+                if min_pivot.is_nan() || min_pivot < floor || det == 0.0 {
+                    return None;
+                }
+                negative += if det < 0.0 {
+                    1
+                } else if a < 0.0 {
+                    2
+                } else {
+                    0
+                };
+                inv.copy_from_slice(&[c / det, -b / det, -b / det, a / det]);
+            } else {
+                let piv = &mut self.g_piv[g.first..g.first + q];
+                negative += factor_above(&mut *gm, q, piv, &mut self.bk_work, floor)?;
+                inv.fill(0.0);
+                for k in 0..q {
+                    inv[k * q + k] = 1.0;
+                }
+                bunch_kaufman::solve_many(gm, q, piv, inv, q);
             }
-            bunch_kaufman::solve_many(gm, q, piv, inv, q);
+            let inv = &*inv;
             let y = &mut self.g_y[g.y_off..g.y_off + q * nn];
             let nz = &mut self.g_nz[g.n_first..g.n_first + nn];
             let mut n_nz = 0;
