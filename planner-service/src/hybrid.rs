@@ -9,6 +9,10 @@
 //! `Optimal` (the NLP converged), `Feasible` (the NLP stopped early with its constraints
 //! within tolerance), `SwarmOnly` (the swarm's lifted path).
 
+mod schedule;
+
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
 use wingman_interfaces::Quality;
@@ -212,6 +216,9 @@ pub struct NlpReport {
     pub objective: f64,
     /// Dense cost of each start after its ranking solve (`NaN`: no feasible result).
     pub ranking: Vec<f64>,
+    /// The starts solved on the working mesh, best ranked first (`ranking.len()`: the
+    /// swarm's best, when no start ranked).
+    pub finalists: Vec<usize>,
 }
 
 /// The planner's answer.
@@ -271,6 +278,8 @@ struct MeshSolve<'a> {
     /// The primal starting point itself (scaled), when it is a solution on this very mesh
     /// (`guess` then only sets the bounds).
     start_x: Option<&'a [f64]>,
+    /// Set when the result is no longer wanted: the solve stops (see `collocation::solve`).
+    cancel: Option<Arc<AtomicBool>>,
 }
 
 /// Solves `job.problem` on `job.mesh` from `job.guess`; `None` if the result is not
@@ -288,6 +297,7 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
         min_time,
         mu_init,
         start_x,
+        cancel,
     } = job;
     if deadline.remaining() <= min_time {
         // No time for even one iteration (the longest set-up and first iteration of the
@@ -320,7 +330,7 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
         None => false,
     };
     start.x = x;
-    let (tr, out) = solve(tr, start, warm, &nlp, deadline)?;
+    let (tr, out) = solve(tr, start, warm, &nlp, deadline, cancel)?;
     let feasible = out.violation <= feasibility_tol;
     let quality = match (out.status, feasible) {
         (NlpStatus::Converged, true) => Some(Quality::Optimal),
@@ -343,47 +353,199 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
 /// iteration's end.
 type SolveResult = Result<(Option<Solved>, usize, NlpStatus, Option<Duration>), PlanError>;
 
-/// Runs `job(i)` for `i in 0..n` on up to `threads` threads; results in index order.
-/// Each thread takes the next unstarted job when it finishes one (solves differ in length
-/// by a factor of three), so the threads stay busy; which thread ran a job does not change
-/// its result.
-fn in_parallel(
-    n: usize,
-    threads: usize,
-    job: impl Fn(usize) -> SolveResult + Sync,
-) -> Vec<SolveResult> {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    let threads = threads.clamp(1, n.max(1));
-    let next = AtomicUsize::new(0);
-    let work = || {
-        let mut done = Vec::new();
-        loop {
-            let i = next.fetch_add(1, Ordering::Relaxed);
-            if i >= n {
-                break done;
-            }
-            done.push((i, job(i)));
-        }
-    };
-    std::thread::scope(|scope| {
-        let work = &work;
-        let helpers: Vec<_> = (1..threads).map(|_| scope.spawn(work)).collect();
-        // The calling thread works too.
-        let mut slots: Vec<Option<SolveResult>> = (0..n).map(|_| None).collect();
-        let mine = work();
-        // A thread that panicked (a solver bug) loses its jobs: they count as failed
-        // starts, and the plan goes on with the others.
-        let theirs = helpers
-            .into_iter()
-            .flat_map(|h| h.join().unwrap_or_default());
-        for (i, r) in mine.into_iter().chain(theirs) {
-            slots[i] = Some(r);
-        }
-        slots
-            .into_iter()
-            .map(|r| r.unwrap_or(Ok((None, 0, NlpStatus::NumericalError, None))))
-            .collect()
-    })
+/// The accepted solution of a solve's result, if any.
+fn accepted_of(r: &SolveResult) -> Option<&Solved> {
+    r.as_ref().ok().and_then(|r| r.0.as_ref())
+}
+
+/// A start's ranking solve on the coarse mesh and, if it was accepted, the path exported
+/// from it with its dense cost.
+struct Ranked {
+    result: SolveResult,
+    path: Option<(f64, Trajectory)>,
+}
+
+/// A finalist's solve on the working mesh.
+struct Finaled {
+    result: SolveResult,
+    mesh: Mesh,
+}
+
+/// A refinement round: its solve and mesh (`None`: the mesh needed no refinement and
+/// there was nothing to polish).
+type Rounded = Option<(SolveResult, Mesh)>;
+
+/// The NLP stage of one plan, as [`schedule`] runs it.
+struct NlpStage<'a> {
+    problem: &'a Problem,
+    settings: &'a PlannerSettings,
+    starts: &'a [Trajectory],
+    /// The ranking mesh of each start.
+    coarse: &'a [Mesh],
+    /// The swarm's best (the fallback candidate's guess).
+    swarm_best: &'a Trajectory,
+    /// How ranked solutions are exported: densely, open loop.
+    reference: ExportSettings,
+    min_time: Duration,
+    deadline: Deadline<'static>,
+}
+
+impl NlpStage<'_> {
+    /// Whether the finalists stop at a looser tolerance than the working one, so that a
+    /// winner whose mesh needs no refinement is solved again on it ("polished").
+    fn polish(&self) -> bool {
+        self.settings.finalist_nlp.tol > self.settings.nlp.tol
+    }
+
+    /// Refinement round `round` after `current`, solved on `mesh`: the refined mesh, or
+    /// (`polish`) the same mesh from `current`'s own solution.
+    fn round_after(
+        &self,
+        round: usize,
+        current: &Solved,
+        mesh: &Mesh,
+        polish: bool,
+        cancel: Option<Arc<AtomicBool>>,
+    ) -> Rounded {
+        let settings = self.settings;
+        let mut errors = Vec::new();
+        interval_errors(&current.tr, &current.x, &mut errors);
+        let refined = if round < settings.refine_rounds {
+            refine(mesh, &errors, &settings.refine)
+        } else {
+            None
+        };
+        let (next, same) = match refined {
+            Some(next) => (next, false),
+            None if polish => (mesh.clone(), true),
+            None => return None,
+        };
+        let mut guess = Trajectory::default();
+        export(&current.tr, &current.x, &self.reference, &mut guess);
+        let result = solve_on_mesh(
+            MeshSolve {
+                problem: self.problem,
+                mesh: &next,
+                guess: &guess,
+                settings,
+                nlp_settings: &settings.nlp,
+                refined: true,
+                feasibility_tol: settings.nlp.feasibility_tol,
+                warm_from: warm_start_of(Some(current), settings.warm_mesh_changes),
+                min_time: self.min_time,
+                mu_init: None,
+                start_x: same.then_some(current.x.as_slice()),
+                cancel,
+            },
+            self.deadline,
+        );
+        Some((result, next))
+    }
+}
+
+impl schedule::Stage for NlpStage<'_> {
+    type Rank = Ranked;
+    type Final = Finaled;
+    type Round = Rounded;
+
+    fn starts(&self) -> usize {
+        self.starts.len()
+    }
+
+    fn rank(&self, i: usize) -> Ranked {
+        let (problem, settings) = (self.problem, self.settings);
+        let result = solve_on_mesh(
+            MeshSolve {
+                problem,
+                mesh: &self.coarse[i],
+                guess: &self.starts[i],
+                settings,
+                nlp_settings: &settings.ranking_nlp,
+                refined: false,
+                feasibility_tol: settings.ranking_feasibility_tol,
+                warm_from: None,
+                min_time: self.min_time,
+                mu_init: if problem.dim() == 3 {
+                    settings.ranking_mu_init_3d
+                } else {
+                    None
+                },
+                start_x: None,
+                cancel: None,
+            },
+            self.deadline,
+        );
+        let path = accepted_of(&result).map(|s| {
+            let mut tr = Trajectory::default();
+            export(&s.tr, &s.x, &self.reference, &mut tr);
+            // Rank by the path's cost re-evaluated densely: the coarse mesh's own
+            // quadrature misjudges sharp exposure transitions by percents.
+            (trajectory_cost(problem, &tr), tr)
+        });
+        Ranked { result, path }
+    }
+
+    fn finalists(&self, ranks: &[Option<&Ranked>]) -> Vec<usize> {
+        let mut order: Vec<(f64, usize, &Trajectory)> = ranks
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| r.and_then(|r| r.path.as_ref()).map(|(c, tr)| (*c, i, tr)))
+            .collect();
+        // Lowest cost first; ties go to the earlier start (deterministic).
+        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        finalists(&order, self.settings)
+    }
+
+    fn finalist(&self, _c: usize, rank: Option<&Ranked>, cancel: Arc<AtomicBool>) -> Finaled {
+        let settings = self.settings;
+        // A finalist starts from its coarse solution; the fallback from the swarm's best.
+        let (guess, coarse) = match rank.and_then(|r| r.path.as_ref().map(|p| (&p.1, r))) {
+            Some((path, r)) => (path, accepted_of(&r.result)),
+            None => (self.swarm_best, None),
+        };
+        let mesh = Mesh::uniform(
+            settings.mesh.points,
+            &phase_durations(self.problem.t0, guess),
+            settings.mesh.interval_s,
+            settings.mesh.min_intervals,
+        );
+        let result = solve_on_mesh(
+            MeshSolve {
+                problem: self.problem,
+                mesh: &mesh,
+                guess,
+                settings,
+                nlp_settings: &settings.finalist_nlp,
+                refined: true,
+                feasibility_tol: settings.nlp.feasibility_tol,
+                warm_from: warm_start_of(coarse, settings.warm_mesh_changes),
+                min_time: self.min_time,
+                mu_init: None,
+                start_x: None,
+                cancel: Some(cancel),
+            },
+            self.deadline,
+        );
+        Finaled { result, mesh }
+    }
+
+    fn judge(&self, f: &Finaled) -> Option<(f64, bool)> {
+        let rounds = self.settings.refine_rounds.max(usize::from(self.polish()));
+        accepted_of(&f.result).map(|s| (s.objective, s.quality == Quality::Optimal && rounds > 0))
+    }
+
+    fn round(&self, _c: usize, f: &Finaled, cancel: Arc<AtomicBool>) -> Rounded {
+        let current = accepted_of(&f.result)?;
+        self.round_after(0, current, &f.mesh, self.polish(), Some(cancel))
+    }
+
+    fn expired(&self) -> bool {
+        self.deadline.expired()
+    }
+
+    fn now(&self) -> Duration {
+        self.deadline.clock().now()
+    }
 }
 
 impl Planner {
@@ -445,6 +607,7 @@ impl Planner {
             intervals: Vec::new(),
             objective: f64::NAN,
             ranking: Vec::new(),
+            finalists: Vec::new(),
         };
         // Starts from distinct basins, solved side by side on the first mesh.
         // The swarm's workspace holds this problem's seeds: no need to build them again.
@@ -456,7 +619,8 @@ impl Planner {
         let starts = basins::candidates(problem, &sw.best, self.swarm.seeds(), count, |tr| {
             trajectory_cost(problem, tr)
         });
-        // 1. Rank every start on the coarse mesh.
+        // Rank every start on the coarse mesh, solve the best distinct ones on the working
+        // mesh, refine the best of those: scheduled on the planner's threads (`schedule`).
         let rank = if problem.dim() == 3 {
             &settings.ranking_mesh_3d
         } else {
@@ -473,163 +637,78 @@ impl Planner {
                 )
             })
             .collect();
-        let ranked = in_parallel(starts.len(), settings.threads, |i| {
-            solve_on_mesh(
-                MeshSolve {
-                    problem,
-                    mesh: &coarse[i],
-                    guess: &starts[i],
-                    settings,
-                    nlp_settings: &settings.ranking_nlp,
-                    refined: false,
-                    feasibility_tol: settings.ranking_feasibility_tol,
-                    warm_from: None,
-                    min_time,
-                    mu_init: if problem.dim() == 3 {
-                        settings.ranking_mu_init_3d
-                    } else {
-                        None
-                    },
-                    start_x: None,
-                },
-                deadline,
-            )
-        });
-        times.ranking = clock.now().saturating_sub(nlp_started);
-        let mut order: Vec<(f64, usize, Trajectory)> = Vec::new();
-        let reference = ExportSettings {
-            closed_loop: false,
-            max_step_s: settings.export.max_step_s / 2.0,
-            ..settings.export
+        let stage = NlpStage {
+            problem,
+            settings,
+            starts: &starts,
+            coarse: &coarse,
+            swarm_best: &sw.best,
+            reference: ExportSettings {
+                closed_loop: false,
+                max_step_s: settings.export.max_step_s / 2.0,
+                ..settings.export
+            },
+            min_time,
+            deadline,
         };
-        let mut coarse_solved: Vec<Option<Solved>> = Vec::with_capacity(ranked.len());
-        for (i, r) in ranked.into_iter().enumerate() {
-            let (solved, iterations, status, first) = r?;
+        let done = schedule::run(&stage, settings.threads);
+        times.ranking = done.ranked_at.saturating_sub(nlp_started);
+        report.finalists = done.chosen;
+        // The report and any error in the step-by-step order: ranks, finals, rounds. A
+        // task that failed (panicked) counts as a failed solve.
+        let failed = || Ok((None, 0, NlpStatus::NumericalError, None));
+        for r in done.ranks {
+            let (path, result) = match r {
+                Some(Ranked { result, path }) => (path, result),
+                None => (None, failed()),
+            };
+            let (_, iterations, status, first) = result?;
             setup = setup.max(first.unwrap_or_default());
             report.iterations.push(iterations);
             report.status = Some(status);
-            coarse_solved.push(None);
-            if let Some(s) = solved {
-                let mut tr = Trajectory::default();
-                export(&s.tr, &s.x, &reference, &mut tr);
-                // Rank by the path's cost re-evaluated densely: the coarse mesh's own
-                // quadrature misjudges sharp exposure transitions by percents.
-                let cost = trajectory_cost(problem, &tr);
-                report.ranking.push(cost);
-                order.push((cost, i, tr));
-                coarse_solved[i] = Some(s);
-            } else {
-                report.ranking.push(f64::NAN);
-            }
+            report.ranking.push(path.map_or(f64::NAN, |p| p.0));
         }
-        // Lowest objective first; ties go to the earlier start (deterministic).
-        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let mut order = finalists(order, settings);
-        if order.is_empty() {
-            // No start ranked (e.g. no time): try the swarm's best on the working mesh.
-            order.push((f64::INFINITY, 0, sw.best.clone()));
-        }
-        // 2. The finalists on the working mesh, from their coarse solutions.
-        let fine: Vec<Mesh> = order
-            .iter()
-            .map(|(_, _, g)| {
-                Mesh::uniform(
-                    settings.mesh.points,
-                    &phase_durations(problem.t0, g),
-                    settings.mesh.interval_s,
-                    settings.mesh.min_intervals,
-                )
-            })
-            .collect();
-        let warm = settings.warm_mesh_changes;
-        let finals = in_parallel(order.len(), settings.threads, |i| {
-            solve_on_mesh(
-                MeshSolve {
-                    problem,
-                    mesh: &fine[i],
-                    guess: &order[i].2,
-                    settings,
-                    nlp_settings: &settings.finalist_nlp,
-                    refined: true,
-                    feasibility_tol: settings.nlp.feasibility_tol,
-                    warm_from: coarse_solved
-                        .get(order[i].1)
-                        .and_then(|s| warm_start_of(s, warm)),
-                    min_time,
-                    mu_init: None,
-                    start_x: None,
-                },
-                deadline,
-            )
-        });
-        drop(coarse_solved);
-        let mut accepted: Option<Solved> = None;
-        let mut mesh = fine[0].clone();
-        for (i, r) in finals.into_iter().enumerate() {
-            let (solved, iterations, status, first) = r?;
+        let mut accepted: Option<(Solved, Mesh)> = None;
+        for (k, f) in done.finals.into_iter().enumerate() {
+            let (result, fine) = match f {
+                Some(Finaled { result, mesh }) => (result, Some(mesh)),
+                None => (failed(), None),
+            };
+            let (solved, iterations, status, first) = result?;
             setup = setup.max(first.unwrap_or_default());
             report.iterations.push(iterations);
             report.status = Some(status);
-            if let Some(s) = solved
-                && accepted.as_ref().is_none_or(|a| s.objective < a.objective)
+            if done.winner == Some(k)
+                && let (Some(s), Some(fine)) = (solved, fine)
             {
-                mesh = fine[i].clone();
-                accepted = Some(s);
+                accepted = Some((s, fine));
             }
         }
-        let mut guess = Trajectory::default();
-        // The finalists may stop at a looser tolerance than the working one, as a refined
-        // solve follows; when the mesh needs no refinement, the accepted finalist is
-        // solved again on its own mesh, from its own solution ("polished").
-        let mut polish = settings.finalist_nlp.tol > settings.nlp.tol;
-        for round in 0..settings.refine_rounds.max(usize::from(polish)) {
-            let Some(current) = accepted.as_ref() else {
+        // The first round ran in the schedule; the others (if any) follow it here.
+        let mut round_result = done.round.flatten();
+        for round in 0..settings.refine_rounds.max(usize::from(stage.polish())) {
+            let Some((current, mesh)) = accepted.as_ref() else {
                 break;
             };
-            if current.quality != Quality::Optimal || deadline.expired() {
+            let next = if round == 0 {
+                round_result.take()
+            } else if current.quality != Quality::Optimal || deadline.expired() {
                 break;
-            }
-            let mut errors = Vec::new();
-            interval_errors(&current.tr, &current.x, &mut errors);
-            let refined = if round < settings.refine_rounds {
-                refine(&mesh, &errors, &settings.refine)
             } else {
-                None
+                stage.round_after(round, current, mesh, false, None)
             };
-            let (next, same) = match refined {
-                Some(next) => (next, false),
-                None if polish => (mesh.clone(), true),
-                None => break,
+            let Some((result, next)) = next else {
+                break;
             };
-            polish = false;
-            export(&current.tr, &current.x, &reference, &mut guess);
-            let (solved, iterations, status, _) = solve_on_mesh(
-                MeshSolve {
-                    problem,
-                    mesh: &next,
-                    guess: &guess,
-                    settings,
-                    nlp_settings: &settings.nlp,
-                    refined: true,
-                    feasibility_tol: settings.nlp.feasibility_tol,
-                    warm_from: warm_start_of(&accepted, warm),
-                    min_time,
-                    mu_init: None,
-                    start_x: same.then_some(current.x.as_slice()),
-                },
-                deadline,
-            )?;
+            let (solved, iterations, status, _) = result?;
             report.iterations.push(iterations);
             report.status = Some(status);
             match solved {
-                Some(s) => {
-                    accepted = Some(s);
-                    mesh = next;
-                }
+                Some(s) => accepted = Some((s, next)),
                 None => break,
             }
         }
-        if let Some(a) = &accepted {
+        if let Some((a, mesh)) = &accepted {
             report.objective = a.objective;
             report.status = Some(a.status);
             report.intervals = mesh.phases.iter().map(Vec::len).collect();
@@ -646,7 +725,7 @@ impl Planner {
 
         let export_started = clock.now();
         let (quality, trajectory) = match &accepted {
-            Some(a) => {
+            Some((a, _)) => {
                 let mut flown = Trajectory::default();
                 export(&a.tr, &a.x, &settings.export, &mut flown);
                 (a.quality, flown)
@@ -676,12 +755,9 @@ impl Planner {
 /// ranked cost within `finalist_duplicate_tol` of it, relative, on a path not distinct
 /// from it: the same basin reached twice) nor out of the race (above the best by more
 /// than `finalist_gap_tol`).
-fn finalists(
-    ranked: Vec<(f64, usize, Trajectory)>,
-    settings: &PlannerSettings,
-) -> Vec<(f64, usize, Trajectory)> {
-    let mut taken: Vec<(f64, usize, Trajectory)> = Vec::with_capacity(settings.finalists);
-    for r in ranked {
+fn finalists(ranked: &[(f64, usize, &Trajectory)], settings: &PlannerSettings) -> Vec<usize> {
+    let mut taken: Vec<(f64, usize, &Trajectory)> = Vec::with_capacity(settings.finalists);
+    for &r in ranked {
         let Some(best) = taken.first().map(|t| t.0) else {
             taken.push(r);
             continue;
@@ -693,18 +769,18 @@ fn finalists(
         }
         let duplicate = taken.iter().any(|t| {
             (r.0 - t.0).abs() <= settings.finalist_duplicate_tol * t.0.abs()
-                && basins::separation(&r.2, &t.2) <= basins::MIN_SEPARATION_M
+                && basins::separation(r.2, t.2) <= basins::MIN_SEPARATION_M
         });
         if !duplicate {
             taken.push(r);
         }
     }
-    taken
+    taken.into_iter().map(|t| t.1).collect()
 }
 
 /// The transcription and primal-dual solution of `solved` to warm-start the next mesh from.
-fn warm_start_of(solved: &Option<Solved>, enabled: bool) -> Option<(&Transcription, &PrimalDual)> {
-    let s = solved.as_ref().filter(|_| enabled)?;
+fn warm_start_of(solved: Option<&Solved>, enabled: bool) -> Option<(&Transcription, &PrimalDual)> {
+    let s = solved.filter(|_| enabled)?;
     s.warm.as_ref().map(|w| (&s.tr, w))
 }
 
@@ -788,18 +864,15 @@ mod tests {
     #[test]
     fn finalists_skip_duplicates_and_starts_out_of_the_race() {
         let settings = PlannerSettings::default();
-        let ranked = |entries: &[(f64, f64)]| -> Vec<(f64, usize, Trajectory)> {
-            entries
-                .iter()
-                .enumerate()
-                .map(|(i, &(cost, y))| (cost, i, line(y)))
-                .collect()
-        };
         let picked = |entries: &[(f64, f64)]| -> Vec<usize> {
-            finalists(ranked(entries), &settings)
+            let paths: Vec<Trajectory> = entries.iter().map(|e| line(e.1)).collect();
+            let ranked: Vec<(f64, usize, &Trajectory)> = entries
                 .iter()
-                .map(|f| f.1)
-                .collect()
+                .zip(&paths)
+                .enumerate()
+                .map(|(i, (&(cost, _), tr))| (cost, i, tr))
+                .collect();
+            finalists(&ranked, &settings)
         };
         // A close cost on a path 100 m away is the same basin: the next distinct one goes.
         assert_eq!(picked(&[(10.0, 0.0), (10.005, 100.0), (10.2, 9e3)]), [0, 2]);
@@ -813,6 +886,6 @@ mod tests {
             picked(&[(10.0, 0.0), (10.1, 9e3), (10.2, -9e3), (10.3, 2e4)]),
             [0, 1]
         );
-        assert!(finalists(Vec::new(), &settings).is_empty());
+        assert!(finalists(&[], &settings).is_empty());
     }
 }

@@ -51,6 +51,7 @@ fn same_objective(name: &str) {
             false,
             &nlp,
             Deadline::after(clock(), Duration::from_secs(60)),
+            None,
         )
         .unwrap();
         assert_eq!(

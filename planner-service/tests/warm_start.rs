@@ -61,6 +61,7 @@ fn solve_counted(
         is_warm,
         &settings,
         Deadline::after(clock(), Duration::from_secs(60)),
+        None,
     )
     .unwrap();
     assert_eq!(out.status, NlpStatus::Converged, "{:?}", out.return_status);

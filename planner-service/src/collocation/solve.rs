@@ -11,6 +11,8 @@
 
 use std::cell::RefCell;
 use std::rc::Rc;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use pounce_rs::pounce_common::options_list::OptionsList;
@@ -180,6 +182,9 @@ struct Adapter {
     /// The longest iteration so far: a solve that has less time left stops now rather
     /// than one iteration past its deadline.
     longest_iteration: Duration,
+    /// Set by another thread when this solve's result is no longer wanted: it stops at
+    /// the end of the iteration (as at a deadline).
+    cancel: Option<Arc<AtomicBool>>,
 }
 
 impl TNLP for Adapter {
@@ -315,7 +320,11 @@ impl TNLP for Adapter {
             self.longest_iteration = self.longest_iteration.max(took);
         }
         self.last_iteration_end = now;
-        self.deadline.remaining() > self.longest_iteration
+        let cancelled = self
+            .cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed));
+        !cancelled && self.deadline.remaining() > self.longest_iteration
     }
 }
 
@@ -491,13 +500,15 @@ fn install_structured_kkt(app: &mut IpoptApplication, labels: Option<KktLabels>)
 }
 
 /// Solves `tr` from the scaled start `start` (with its duals when `warm_start`), stopping
-/// at `deadline`. Returns the transcription back with the outcome.
+/// at `deadline`, or at the end of the iteration in which `cancel` is found set (status
+/// [`NlpStatus::MaxTime`]). Returns the transcription back with the outcome.
 pub fn solve(
     tr: Transcription,
     start: PrimalDual,
     warm_start: bool,
     settings: &NlpSettings,
     deadline: Deadline<'static>,
+    cancel: Option<Arc<AtomicBool>>,
 ) -> Result<(Transcription, NlpOutcome), OptionError> {
     let clock = deadline.clock();
     let began = clock.now();
@@ -519,6 +530,7 @@ pub fn solve(
         last_iteration_end: began,
         first_iteration: None,
         longest_iteration: Duration::ZERO,
+        cancel,
     }));
     let dyn_adapter: Rc<RefCell<dyn TNLP>> = adapter.clone();
     let return_status = app.optimize_tnlp(dyn_adapter);
