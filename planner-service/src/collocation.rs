@@ -16,5 +16,5 @@ pub use kkt::{KktLabels, KktSolver, StructuredKkt};
 pub use lgr::Lgr;
 pub use mesh::{Layout, Mesh};
 pub use refine::{RefineSettings, interval_errors, refine};
-pub use solve::{NlpOutcome, NlpSettings, NlpStatus, PrimalDual, solve};
+pub use solve::{NlpOutcome, NlpSettings, NlpStatus, PrimalDual, SolveBudget, solve};
 pub use transcription::{Transcription, TranscriptionSettings};

@@ -10,6 +10,7 @@
 //! within tolerance), `SwarmOnly` (the swarm's lifted path).
 
 mod schedule;
+mod timing;
 
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
@@ -20,12 +21,13 @@ use wingman_interfaces::Quality;
 use crate::basins;
 use crate::clock::Deadline;
 use crate::collocation::{
-    ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, RefineSettings, Transcription,
-    TranscriptionSettings, export, fly, interval_errors, refine, solve,
+    ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, RefineSettings, SolveBudget,
+    Transcription, TranscriptionSettings, export, fly, interval_errors, refine, solve,
 };
 use crate::problem::Problem;
 use crate::swarm::{self, SwarmOutcome, SwarmSettings, SwarmWorkspace};
 use crate::trajectory::Trajectory;
+use timing::{Seen, SolveTiming};
 
 /// How each phase's first mesh is cut.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -240,9 +242,9 @@ pub struct PlanOutcome {
 /// The planner with its reusable workspace.
 pub struct Planner {
     swarm: SwarmWorkspace,
-    /// Per model (2-D, 3-D): about the longest time an NLP solve took to end its first
-    /// iteration in recent plans. A solve is not started with less time left.
-    setup: [Duration; 2],
+    /// Per model (2-D, 3-D): about the longest set-up, iteration and wrap-up of the NLP
+    /// solves of recent plans, to keep the deadline.
+    timing: [SolveTiming; 2],
 }
 
 /// One NLP solve's accepted result.
@@ -271,8 +273,9 @@ struct MeshSolve<'a> {
     feasibility_tol: f64,
     /// The previous mesh's transcription and primal-dual solution, to start from.
     warm_from: Option<(&'a Transcription, &'a PrimalDual)>,
-    /// Do not start with less time than this left.
-    min_time: Duration,
+    /// The solves' expected timing: none is started without time for its set-up and
+    /// wrap-up, and it stops while an iteration and its wrap-up still fit.
+    timing: SolveTiming,
     /// The first barrier parameter, over `nlp_settings`' (`None`: theirs).
     mu_init: Option<f64>,
     /// The primal starting point itself (scaled), when it is a solution on this very mesh
@@ -294,15 +297,15 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
         refined,
         feasibility_tol,
         warm_from,
-        min_time,
+        timing,
         mu_init,
         start_x,
         cancel,
     } = job;
-    if deadline.remaining() <= min_time {
-        // No time for even one iteration (the longest set-up and first iteration of the
-        // last plan): do not build the NLP; the caller returns what it has.
-        return Ok((None, 0, NlpStatus::MaxTime, None));
+    if deadline.remaining() <= timing.setup + timing.wrap_up {
+        // No time for even one iteration (the longest set-up and first iteration of
+        // recent solves): do not build the NLP; the caller returns what it has.
+        return Ok((None, 0, NlpStatus::MaxTime, SolveTiming::default()));
     }
     let mut tr = Transcription::new(problem, mesh, guess, &settings.transcription);
     let mut x = vec![0.0; tr.n_vars()];
@@ -330,7 +333,19 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
         None => false,
     };
     start.x = x;
-    let (tr, out) = solve(tr, start, warm, &nlp, deadline, cancel)?;
+    let budget = SolveBudget {
+        deadline,
+        cancel,
+        iteration: timing.iteration(tr.n_vars()),
+        wrap_up: timing.wrap_up,
+    };
+    let vars = tr.n_vars();
+    let (tr, out) = solve(tr, start, warm, &nlp, budget)?;
+    let seen = SolveTiming {
+        setup: out.first_iteration.unwrap_or_default(),
+        per_var: out.longest_iteration.as_secs_f64() / vars.max(1) as f64,
+        wrap_up: out.wrap_up,
+    };
     let feasible = out.violation <= feasibility_tol;
     let quality = match (out.status, feasible) {
         (NlpStatus::Converged, true) => Some(Quality::Optimal),
@@ -346,12 +361,11 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
         status: out.status,
         warm: out.warm,
     });
-    Ok((solved, out.iterations, out.status, out.first_iteration))
+    Ok((solved, out.iterations, out.status, seen))
 }
 
-/// A mesh solve's accepted result (if any), iterations, status and time to its first
-/// iteration's end.
-type SolveResult = Result<(Option<Solved>, usize, NlpStatus, Option<Duration>), PlanError>;
+/// A mesh solve's accepted result (if any), iterations, status and timing.
+type SolveResult = Result<(Option<Solved>, usize, NlpStatus, SolveTiming), PlanError>;
 
 /// The accepted solution of a solve's result, if any.
 fn accepted_of(r: &SolveResult) -> Option<&Solved> {
@@ -386,11 +400,30 @@ struct NlpStage<'a> {
     swarm_best: &'a Trajectory,
     /// How ranked solutions are exported: densely, open loop.
     reference: ExportSettings,
-    min_time: Duration,
+    /// The solves' timing learned from recent plans.
+    timing: SolveTiming,
+    /// The timing of this plan's solves so far.
+    seen: Seen,
     deadline: Deadline<'static>,
 }
 
 impl NlpStage<'_> {
+    /// Runs `job` with the timing known now (recent plans' and this one's so far), and
+    /// records its own.
+    fn solve(&self, job: MeshSolve<'_>) -> SolveResult {
+        let result = solve_on_mesh(
+            MeshSolve {
+                timing: self.timing.max(self.seen.get()),
+                ..job
+            },
+            self.deadline,
+        );
+        if let Ok((_, _, _, seen)) = &result {
+            self.seen.record(*seen);
+        }
+        result
+    }
+
     /// Whether the finalists stop at a looser tolerance than the working one, so that a
     /// winner whose mesh needs no refinement is solved again on it ("polished").
     fn polish(&self) -> bool {
@@ -422,23 +455,20 @@ impl NlpStage<'_> {
         };
         let mut guess = Trajectory::default();
         export(&current.tr, &current.x, &self.reference, &mut guess);
-        let result = solve_on_mesh(
-            MeshSolve {
-                problem: self.problem,
-                mesh: &next,
-                guess: &guess,
-                settings,
-                nlp_settings: &settings.nlp,
-                refined: true,
-                feasibility_tol: settings.nlp.feasibility_tol,
-                warm_from: warm_start_of(Some(current), settings.warm_mesh_changes),
-                min_time: self.min_time,
-                mu_init: None,
-                start_x: same.then_some(current.x.as_slice()),
-                cancel,
-            },
-            self.deadline,
-        );
+        let result = self.solve(MeshSolve {
+            problem: self.problem,
+            mesh: &next,
+            guess: &guess,
+            settings,
+            nlp_settings: &settings.nlp,
+            refined: true,
+            feasibility_tol: settings.nlp.feasibility_tol,
+            warm_from: warm_start_of(Some(current), settings.warm_mesh_changes),
+            timing: SolveTiming::default(),
+            mu_init: None,
+            start_x: same.then_some(current.x.as_slice()),
+            cancel,
+        });
         Some((result, next))
     }
 }
@@ -454,27 +484,24 @@ impl schedule::Stage for NlpStage<'_> {
 
     fn rank(&self, i: usize) -> Ranked {
         let (problem, settings) = (self.problem, self.settings);
-        let result = solve_on_mesh(
-            MeshSolve {
-                problem,
-                mesh: &self.coarse[i],
-                guess: &self.starts[i],
-                settings,
-                nlp_settings: &settings.ranking_nlp,
-                refined: false,
-                feasibility_tol: settings.ranking_feasibility_tol,
-                warm_from: None,
-                min_time: self.min_time,
-                mu_init: if problem.dim() == 3 {
-                    settings.ranking_mu_init_3d
-                } else {
-                    None
-                },
-                start_x: None,
-                cancel: None,
+        let result = self.solve(MeshSolve {
+            problem,
+            mesh: &self.coarse[i],
+            guess: &self.starts[i],
+            settings,
+            nlp_settings: &settings.ranking_nlp,
+            refined: false,
+            feasibility_tol: settings.ranking_feasibility_tol,
+            warm_from: None,
+            timing: SolveTiming::default(),
+            mu_init: if problem.dim() == 3 {
+                settings.ranking_mu_init_3d
+            } else {
+                None
             },
-            self.deadline,
-        );
+            start_x: None,
+            cancel: None,
+        });
         let path = accepted_of(&result).map(|s| {
             let mut tr = Trajectory::default();
             export(&s.tr, &s.x, &self.reference, &mut tr);
@@ -509,23 +536,20 @@ impl schedule::Stage for NlpStage<'_> {
             settings.mesh.interval_s,
             settings.mesh.min_intervals,
         );
-        let result = solve_on_mesh(
-            MeshSolve {
-                problem: self.problem,
-                mesh: &mesh,
-                guess,
-                settings,
-                nlp_settings: &settings.finalist_nlp,
-                refined: true,
-                feasibility_tol: settings.nlp.feasibility_tol,
-                warm_from: warm_start_of(coarse, settings.warm_mesh_changes),
-                min_time: self.min_time,
-                mu_init: None,
-                start_x: None,
-                cancel: Some(cancel),
-            },
-            self.deadline,
-        );
+        let result = self.solve(MeshSolve {
+            problem: self.problem,
+            mesh: &mesh,
+            guess,
+            settings,
+            nlp_settings: &settings.finalist_nlp,
+            refined: true,
+            feasibility_tol: settings.nlp.feasibility_tol,
+            warm_from: warm_start_of(coarse, settings.warm_mesh_changes),
+            timing: SolveTiming::default(),
+            mu_init: None,
+            start_x: None,
+            cancel: Some(cancel),
+        });
         Finaled { result, mesh }
     }
 
@@ -552,7 +576,7 @@ impl Planner {
     pub fn new(settings: &PlannerSettings) -> Planner {
         Planner {
             swarm: SwarmWorkspace::new(&settings.swarm),
-            setup: [Duration::ZERO; 2],
+            timing: [SolveTiming::default(); 2],
         }
     }
 
@@ -598,9 +622,6 @@ impl Planner {
 
         let nlp_started = clock.now();
         let model = usize::from(problem.dim() == 3);
-        let min_time = self.setup[model];
-        // The longest time to a first iteration among this plan's solves.
-        let mut setup = Duration::ZERO;
         let mut report = NlpReport {
             status: None,
             iterations: Vec::new(),
@@ -648,7 +669,8 @@ impl Planner {
                 max_step_s: settings.export.max_step_s / 2.0,
                 ..settings.export
             },
-            min_time,
+            timing: self.timing[model],
+            seen: Seen::default(),
             deadline,
         };
         let done = schedule::run(&stage, settings.threads);
@@ -656,14 +678,13 @@ impl Planner {
         report.finalists = done.chosen;
         // The report and any error in the step-by-step order: ranks, finals, rounds. A
         // task that failed (panicked) counts as a failed solve.
-        let failed = || Ok((None, 0, NlpStatus::NumericalError, None));
+        let failed = || Ok((None, 0, NlpStatus::NumericalError, SolveTiming::default()));
         for r in done.ranks {
             let (path, result) = match r {
                 Some(Ranked { result, path }) => (path, result),
                 None => (None, failed()),
             };
-            let (_, iterations, status, first) = result?;
-            setup = setup.max(first.unwrap_or_default());
+            let (_, iterations, status, _) = result?;
             report.iterations.push(iterations);
             report.status = Some(status);
             report.ranking.push(path.map_or(f64::NAN, |p| p.0));
@@ -674,8 +695,7 @@ impl Planner {
                 Some(Finaled { result, mesh }) => (result, Some(mesh)),
                 None => (failed(), None),
             };
-            let (solved, iterations, status, first) = result?;
-            setup = setup.max(first.unwrap_or_default());
+            let (solved, iterations, status, _) = result?;
             report.iterations.push(iterations);
             report.status = Some(status);
             if done.winner == Some(k)
@@ -715,13 +735,7 @@ impl Planner {
             let _ = a.iterations;
         }
         times.nlp = clock.now().saturating_sub(nlp_started);
-        // Remember the set-up time, forgetting older, slower plans slowly (and retrying
-        // after plans that had no time to start a solve at all).
-        self.setup[model] = if setup > Duration::ZERO {
-            setup.max(self.setup[model] / 2)
-        } else {
-            self.setup[model].mul_f64(0.9)
-        };
+        self.timing[model] = self.timing[model].after(stage.seen.get());
 
         let export_started = clock.now();
         let (quality, trajectory) = match &accepted {

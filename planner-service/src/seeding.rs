@@ -449,6 +449,18 @@ pub fn seeds(
     settings: &SeedSettings,
     out: &mut Vec<Seed>,
 ) -> Result<(), SeedError> {
+    seeds_until(problem, settings, out, &|| false)
+}
+
+/// [`seeds`], but once `stop()` says so (checked before each seed is built, after the
+/// first) the seeds not yet built are left out: the most promising come first (the
+/// scan's, cheapest first, then the arcs, the fixed-time fits, the random curves).
+pub fn seeds_until(
+    problem: &Problem,
+    settings: &SeedSettings,
+    out: &mut Vec<Seed>,
+    stop: &dyn Fn() -> bool,
+) -> Result<(), SeedError> {
     settings.validate()?;
     let ctx = Context::new(problem, settings)?;
     let mut rng = ChaCha8Rng::seed_from_u64(settings.rng_seed);
@@ -597,6 +609,9 @@ pub fn seeds(
 
     let mut count = 0;
     for spec in &specs {
+        if count > 0 && stop() {
+            break;
+        }
         if out.len() <= count {
             out.push(Seed::default());
         }

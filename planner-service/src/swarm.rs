@@ -599,18 +599,22 @@ impl Shard {
         }
     }
 
-    /// Flies and prices seeds `first, first + stride, ...`.
+    /// Flies and prices seeds `first, first + stride, ...`, the first of them at least and
+    /// the others until `deadline` (the seeds left out are not scored: they rank last).
     fn evaluate_seeds(
         &mut self,
         g: &Grid,
         seeds: &[Seed],
         lookahead: f64,
-        first: usize,
-        stride: usize,
+        (first, stride): (usize, usize),
+        deadline: &Deadline<'_>,
     ) {
         let dim = g.dim();
         self.seed_scores.clear();
         for i in (first..seeds.len()).step_by(stride) {
+            if !self.seed_scores.is_empty() && deadline.expired() {
+                break;
+            }
             let u = &mut self.seed_u[..dim];
             eval::track(g, &seeds[i], lookahead, u);
             let score = eval::evaluate(g, u, &mut self.scratch).score;
@@ -840,7 +844,10 @@ pub fn run(
         .map_err(|e| SwarmError::Problem(e.to_string()))?;
     ws.reserve(settings);
     ws.lookahead = settings.lookahead;
-    seeding::seeds(problem, &settings.seeds, &mut ws.seeds)?;
+    // Under a deadline too short for them all, the most promising seeds only.
+    seeding::seeds_until(problem, &settings.seeds, &mut ws.seeds, &|| {
+        deadline.expired()
+    })?;
 
     // Horizon and grid: long enough for every seed within 1.5 times the shortest seed's
     // duration (and for a fixed final time), plus the margin. Longer seeds may not reach
@@ -938,7 +945,13 @@ pub fn run(
                         break;
                     }
                     match job.load(Ordering::Acquire) {
-                        JOB_SEEDS => lock(shard).evaluate_seeds(grid, seeds, lookahead, t, threads),
+                        JOB_SEEDS => lock(shard).evaluate_seeds(
+                            grid,
+                            seeds,
+                            lookahead,
+                            (t, threads),
+                            &deadline,
+                        ),
                         JOB_PARTICLES => lock(shard).evaluate(grid, dim),
                         _ => break,
                     }
@@ -958,7 +971,7 @@ pub fn run(
             {
                 let mut sh = lock(&shards[0]);
                 if what == JOB_SEEDS {
-                    sh.evaluate_seeds(grid, seeds, lookahead, 0, threads);
+                    sh.evaluate_seeds(grid, seeds, lookahead, (0, threads), &deadline);
                 } else {
                     sh.evaluate(grid, dim);
                 }

@@ -7,8 +7,8 @@ use std::time::Duration;
 use wingman_planner::clock::Deadline;
 use wingman_planner::collocation::kkt::block_factorizations_total;
 use wingman_planner::collocation::{
-    KktLabels, KktSolver, Mesh, NlpSettings, NlpStatus, PrimalDual, StructuredKkt, Transcription,
-    TranscriptionSettings, solve,
+    KktLabels, KktSolver, Mesh, NlpSettings, NlpStatus, PrimalDual, SolveBudget, StructuredKkt,
+    Transcription, TranscriptionSettings, solve,
 };
 use wingman_planner::hybrid::phase_durations;
 
@@ -50,8 +50,7 @@ fn same_objective(name: &str) {
             start,
             false,
             &nlp,
-            Deadline::after(clock(), Duration::from_secs(60)),
-            None,
+            SolveBudget::until(Deadline::after(clock(), Duration::from_secs(60))),
         )
         .unwrap();
         assert_eq!(

@@ -232,7 +232,9 @@ impl Clock for TickingClock {
 }
 
 /// The deadline is checked every iteration: on a clock that advances 1 ms per reading, a
-/// 30 ms budget stops the run after some iterations with `MaxTime` and a valid best path.
+/// budget that covers the seeds (each built and each scored reads the clock once) and 30
+/// more readings stops the run after some iterations with `MaxTime` and a valid best
+/// path.
 #[test]
 fn a_deadline_during_the_run_stops_it() {
     let p = problem("2d-min-time-avoidable");
@@ -240,15 +242,17 @@ fn a_deadline_during_the_run_stops_it() {
         .with_max_iterations(1000)
         .with_stall_iterations(1000);
     let mut ws = SwarmWorkspace::new(&s);
+    let seeds = run(&p, &s, &mut ws).seeds as u64;
     let clock = TickingClock::default();
     let o = swarm::run(
         &p,
         &s,
         &mut ws,
-        Deadline::after(&clock, Duration::from_millis(30)),
+        Deadline::after(&clock, Duration::from_millis(2 * seeds + 30)),
     )
     .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(o.status, SwarmStatus::MaxTime);
+    assert_eq!(o.seeds as u64, seeds);
     assert!(
         o.iterations > 0 && o.iterations < 40,
         "{} iterations",
@@ -256,6 +260,36 @@ fn a_deadline_during_the_run_stops_it() {
     );
     assert!(o.best.is_valid());
     assert!(o.cost <= o.seeds_best_cost);
+}
+
+/// A deadline too short for the seeds: the first ones are built and scored (at least
+/// one), the rest left out, and the best of those scored comes back, valid.
+#[test]
+fn a_deadline_during_the_seeds_keeps_the_first_ones() {
+    let p = problem("2d-min-time-avoidable");
+    let s = small();
+    let mut ws = SwarmWorkspace::new(&s);
+    let all = run(&p, &s, &mut ws);
+    let clock = TickingClock::default();
+    let o = swarm::run(
+        &p,
+        &s,
+        &mut ws,
+        Deadline::after(&clock, Duration::from_millis(all.seeds as u64 / 2)),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(o.status, SwarmStatus::MaxTime);
+    assert_eq!(o.iterations, 0);
+    assert!(
+        o.seeds >= 1 && o.seeds < all.seeds,
+        "{} of {}",
+        o.seeds,
+        all.seeds
+    );
+    assert!(o.best.is_valid());
+    assert!(o.cost.is_finite());
+    // The seeds built are the first of the full set, in order: the same best or a worse.
+    assert!(o.seeds_best_cost >= all.seeds_best_cost);
 }
 
 /// The swarm's objective of its best 2-D path equals an independent evaluation on the

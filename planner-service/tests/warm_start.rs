@@ -8,8 +8,8 @@ use std::time::Duration;
 use wingman_planner::clock::Deadline;
 use wingman_planner::collocation::warm::transfer;
 use wingman_planner::collocation::{
-    ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, Transcription, TranscriptionSettings,
-    export, solve, transcription::INF,
+    ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, SolveBudget, Transcription,
+    TranscriptionSettings, export, solve, transcription::INF,
 };
 use wingman_planner::hybrid::phase_durations;
 use wingman_planner::problem::Problem;
@@ -60,8 +60,7 @@ fn solve_counted(
         start,
         is_warm,
         &settings,
-        Deadline::after(clock(), Duration::from_secs(60)),
-        None,
+        SolveBudget::until(Deadline::after(clock(), Duration::from_secs(60))),
     )
     .unwrap();
     assert_eq!(out.status, NlpStatus::Converged, "{:?}", out.return_status);

@@ -138,6 +138,34 @@ pub struct PrimalDual {
     pub lambda: Vec<f64>,
 }
 
+/// What bounds a solve in time, besides its settings.
+#[derive(Clone)]
+pub struct SolveBudget {
+    /// The solve stops before an iteration would end past it.
+    pub deadline: Deadline<'static>,
+    /// Set by another thread when the result is no longer wanted: the solve stops at the
+    /// end of the iteration (status [`NlpStatus::MaxTime`]).
+    pub cancel: Option<Arc<AtomicBool>>,
+    /// The expected length of an iteration until one has been measured (the first ones
+    /// of a solve are among its longest).
+    pub iteration: Duration,
+    /// Time kept for the work after the last iteration (the solver's wrap-up, the
+    /// results).
+    pub wrap_up: Duration,
+}
+
+impl SolveBudget {
+    /// Bounded by `deadline` alone.
+    pub fn until(deadline: Deadline<'static>) -> SolveBudget {
+        SolveBudget {
+            deadline,
+            cancel: None,
+            iteration: Duration::ZERO,
+            wrap_up: Duration::ZERO,
+        }
+    }
+}
+
 /// The result of one NLP solve.
 #[derive(Debug, Clone)]
 pub struct NlpOutcome {
@@ -159,6 +187,10 @@ pub struct NlpOutcome {
     pub elapsed: Duration,
     /// Time from the start to the end of the first iteration (`None`: none ended).
     pub first_iteration: Option<Duration>,
+    /// The longest iteration after the first.
+    pub longest_iteration: Duration,
+    /// Time from the end of the last iteration to the return.
+    pub wrap_up: Duration,
 }
 
 /// The TNLP adapter: owns the transcription during the solve.
@@ -167,7 +199,7 @@ struct Adapter {
     tr: Transcription,
     start: PrimalDual,
     warm: bool,
-    deadline: Deadline<'static>,
+    budget: SolveBudget,
     feasibility_tol: f64,
     best: Vec<f64>,
     best_objective: f64,
@@ -182,9 +214,6 @@ struct Adapter {
     /// The longest iteration so far: a solve that has less time left stops now rather
     /// than one iteration past its deadline.
     longest_iteration: Duration,
-    /// Set by another thread when this solve's result is no longer wanted: it stops at
-    /// the end of the iteration (as at a deadline).
-    cancel: Option<Arc<AtomicBool>>,
 }
 
 impl TNLP for Adapter {
@@ -312,7 +341,7 @@ impl TNLP for Adapter {
                 self.best_objective = stats.obj_value;
             }
         }
-        let now = self.deadline.clock().now();
+        let now = self.budget.deadline.clock().now();
         if self.first_iteration.is_none() {
             self.first_iteration = Some(now.saturating_sub(self.began));
         } else {
@@ -320,11 +349,13 @@ impl TNLP for Adapter {
             self.longest_iteration = self.longest_iteration.max(took);
         }
         self.last_iteration_end = now;
-        let cancelled = self
+        let budget = &self.budget;
+        let cancelled = budget
             .cancel
             .as_ref()
             .is_some_and(|c| c.load(Ordering::Relaxed));
-        !cancelled && self.deadline.remaining() > self.longest_iteration
+        let next = self.longest_iteration.max(budget.iteration);
+        !cancelled && budget.deadline.remaining() > next + budget.wrap_up
     }
 }
 
@@ -500,16 +531,15 @@ fn install_structured_kkt(app: &mut IpoptApplication, labels: Option<KktLabels>)
 }
 
 /// Solves `tr` from the scaled start `start` (with its duals when `warm_start`), stopping
-/// at `deadline`, or at the end of the iteration in which `cancel` is found set (status
-/// [`NlpStatus::MaxTime`]). Returns the transcription back with the outcome.
+/// within `budget`. Returns the transcription back with the outcome.
 pub fn solve(
     tr: Transcription,
     start: PrimalDual,
     warm_start: bool,
     settings: &NlpSettings,
-    deadline: Deadline<'static>,
-    cancel: Option<Arc<AtomicBool>>,
+    budget: SolveBudget,
 ) -> Result<(Transcription, NlpOutcome), OptionError> {
+    let deadline = budget.deadline;
     let clock = deadline.clock();
     let began = clock.now();
     let n = tr.n_vars();
@@ -519,7 +549,7 @@ pub fn solve(
         tr,
         start,
         warm: warm_start,
-        deadline,
+        budget,
         feasibility_tol: settings.feasibility_tol,
         best: vec![0.0; n],
         best_objective: f64::INFINITY,
@@ -530,7 +560,6 @@ pub fn solve(
         last_iteration_end: began,
         first_iteration: None,
         longest_iteration: Duration::ZERO,
-        cancel,
     }));
     let dyn_adapter: Rc<RefCell<dyn TNLP>> = adapter.clone();
     let return_status = app.optimize_tnlp(dyn_adapter);
@@ -588,6 +617,11 @@ pub fn solve(
         warm,
         elapsed: clock.now().saturating_sub(began),
         first_iteration: a.first_iteration,
+        longest_iteration: a.longest_iteration,
+        wrap_up: match a.first_iteration {
+            Some(_) => clock.now().saturating_sub(a.last_iteration_end),
+            None => Duration::ZERO,
+        },
     };
     Ok((a.tr, outcome))
 }
