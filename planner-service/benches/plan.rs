@@ -4,8 +4,8 @@
 //! planner returns. Prints a Markdown table (run with `cargo bench -p wingman-planner
 //! --bench plan`; `-- --runs N`, `-- --only NAME` to narrow it).
 //!
-//! The peak heap is counted in a pass of its own (one more plan per scenario), not in
-//! the timed runs: the counting allocator's shared counters, updated by both threads at
+//! The peak heap is counted in a pass of its own (the same plans again), not in the
+//! timed runs: the counting allocator's shared counters, updated by both threads at
 //! every allocation of the solver, cost the timed plans up to 15 %.
 
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -110,19 +110,21 @@ fn main() {
             costs.push(out.cost);
             *qualities.entry(format!("{:?}", out.quality)).or_insert(0) += 1;
         }
-        // The peak heap, in an untimed plan of the first seed.
+        // The peak heap over the same plans, untimed.
         let peak = peak_of(|| {
-            let s = PlannerSettings {
-                swarm: settings.swarm.clone().with_seed(1),
-                ..settings.clone()
-            };
-            let mut planner = Planner::new(&s);
-            let plan = planner.plan(
-                &problem,
-                &s,
-                Deadline::after(clock, Duration::from_secs(30)),
-            );
-            assert!(plan.is_ok());
+            for seed in 1..=runs {
+                let s = PlannerSettings {
+                    swarm: settings.swarm.clone().with_seed(seed),
+                    ..settings.clone()
+                };
+                let mut planner = Planner::new(&s);
+                let plan = planner.plan(
+                    &problem,
+                    &s,
+                    Deadline::after(clock, Duration::from_secs(30)),
+                );
+                assert!(plan.is_ok());
+            }
         }) as f64
             / (1024.0 * 1024.0);
         times.sort_by(f64::total_cmp);
