@@ -273,9 +273,6 @@ struct MeshSolve<'a> {
     feasibility_tol: f64,
     /// The previous mesh's transcription and primal-dual solution, to start from.
     warm_from: Option<(&'a Transcription, &'a PrimalDual)>,
-    /// The solves' expected timing: none is started without time for its set-up and
-    /// wrap-up, and it stops while an iteration and its wrap-up still fit.
-    timing: SolveTiming,
     /// The first barrier parameter, over `nlp_settings`' (`None`: theirs).
     mu_init: Option<f64>,
     /// The primal starting point itself (scaled), when it is a solution on this very mesh
@@ -286,8 +283,13 @@ struct MeshSolve<'a> {
 }
 
 /// Solves `job.problem` on `job.mesh` from `job.guess`; `None` if the result is not
-/// feasible.
-fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult {
+/// feasible. `timing` is the solves' expected timing: none is started without time for
+/// its set-up and wrap-up, and it stops while an iteration and its wrap-up still fit.
+fn solve_on_mesh(
+    job: MeshSolve<'_>,
+    deadline: Deadline<'static>,
+    timing: SolveTiming,
+) -> SolveResult {
     let MeshSolve {
         problem,
         mesh,
@@ -297,7 +299,6 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
         refined,
         feasibility_tol,
         warm_from,
-        timing,
         mu_init,
         start_x,
         cancel,
@@ -333,13 +334,13 @@ fn solve_on_mesh(job: MeshSolve<'_>, deadline: Deadline<'static>) -> SolveResult
         None => false,
     };
     start.x = x;
+    let vars = tr.n_vars();
     let budget = SolveBudget {
         deadline,
         cancel,
-        iteration: timing.iteration(tr.n_vars()),
+        iteration: timing.iteration(vars),
         wrap_up: timing.wrap_up,
     };
-    let vars = tr.n_vars();
     let (tr, out) = solve(tr, start, warm, &nlp, budget)?;
     let seen = SolveTiming {
         setup: out.first_iteration.unwrap_or_default(),
@@ -411,13 +412,7 @@ impl NlpStage<'_> {
     /// Runs `job` with the timing known now (recent plans' and this one's so far), and
     /// records its own.
     fn solve(&self, job: MeshSolve<'_>) -> SolveResult {
-        let result = solve_on_mesh(
-            MeshSolve {
-                timing: self.timing.max(self.seen.get()),
-                ..job
-            },
-            self.deadline,
-        );
+        let result = solve_on_mesh(job, self.deadline, self.timing.max(self.seen.get()));
         if let Ok((_, _, _, seen)) = &result {
             self.seen.record(*seen);
         }
@@ -464,7 +459,6 @@ impl NlpStage<'_> {
             refined: true,
             feasibility_tol: settings.nlp.feasibility_tol,
             warm_from: warm_start_of(Some(current), settings.warm_mesh_changes),
-            timing: SolveTiming::default(),
             mu_init: None,
             start_x: same.then_some(current.x.as_slice()),
             cancel,
@@ -493,7 +487,6 @@ impl schedule::Stage for NlpStage<'_> {
             refined: false,
             feasibility_tol: settings.ranking_feasibility_tol,
             warm_from: None,
-            timing: SolveTiming::default(),
             mu_init: if problem.dim() == 3 {
                 settings.ranking_mu_init_3d
             } else {
@@ -545,7 +538,6 @@ impl schedule::Stage for NlpStage<'_> {
             refined: true,
             feasibility_tol: settings.nlp.feasibility_tol,
             warm_from: warm_start_of(coarse, settings.warm_mesh_changes),
-            timing: SolveTiming::default(),
             mu_init: None,
             start_x: None,
             cancel: Some(cancel),
