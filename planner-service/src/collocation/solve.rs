@@ -15,8 +15,8 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
+use pounce_rs::pounce_algorithm::intermediate::with_current;
 use pounce_rs::pounce_common::options_list::OptionsList;
-use pounce_rs::pounce_nlp::live_iterate::with_current_user_iterate;
 use pounce_rs::{
     AlgorithmMode, ApplicationReturnStatus, BoundsInfo, IndexStyle, IpoptApplication, IpoptCq,
     IpoptData, IterStats, NlpInfo, Solution, SparsityRequest, StartingPoint, TNLP,
@@ -317,20 +317,24 @@ impl TNLP for Adapter {
         });
     }
 
-    fn wants_current_iterate(&self) -> bool {
-        true
-    }
-
     fn intermediate_callback(&mut self, stats: IterStats, _d: &IpoptData, _q: &IpoptCq) -> bool {
         self.iterations = stats.iter.max(0) as usize;
         if stats.mode == AlgorithmMode::RegularMode
             && stats.inf_pr <= self.feasibility_tol
             && (!self.has_best || stats.obj_value < self.best_objective)
         {
+            // Only this iterate's x, read from the algorithm's own state: asking for the
+            // whole user iterate at every iteration (`wants_current_iterate`) builds ten
+            // vectors per iteration, 3 % of a plan's time.
             let best = &mut self.best;
-            let copied = with_current_user_iterate(|it| {
-                if it.x.len() == best.len() {
-                    best.copy_from_slice(&it.x);
+            let copied = with_current(|ctx| {
+                let data = ctx.data.borrow();
+                let Some(curr) = data.curr.as_ref() else {
+                    return false;
+                };
+                let x = ctx.nlp.borrow().finalize_solution_x(&*curr.x);
+                if x.len() == best.len() {
+                    best.copy_from_slice(&x);
                     true
                 } else {
                     false
