@@ -13,6 +13,8 @@
 //! finalists' only); `PROBE_FIN_TOL`, `PROBE_FIN_ACC`, `PROBE_FIN_SOC=0|1` (the finalists'
 //! tolerance, acceptable tolerance, second-order check); `PROBE_FIRST_SEED` (1);
 //! `PROBE_KKT=feral|structured` (the KKT linear solver of every NLP solve);
+//! `PROBE_SOC=0|1` and `PROBE_TOL` (the second-order check and the tolerance of the
+//! refined solves);
 //! `PROBE_ITS=1` prints every plan's NLP iterations per solve (deterministic, unlike times);
 //! `PROBE_OUT=DIR` writes
 //! each plan's `plan.json` / `plan.csv` into `DIR/NAME-SEED/` for the judge.
@@ -131,6 +133,12 @@ fn main() {
                 s.finalist_nlp.extra.push((k.to_string(), v.to_string()));
             }
         }
+    }
+    if let Some(v) = env::<u8>("PROBE_SOC") {
+        s.nlp.second_order_check = v != 0;
+    }
+    if let Some(v) = env("PROBE_TOL") {
+        s.nlp.tol = v;
     }
     if let Some(v) = env("PROBE_FIN_TOL") {
         s.finalist_nlp.tol = v;

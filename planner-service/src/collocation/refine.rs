@@ -28,7 +28,10 @@ pub struct RefineSettings {
 impl Default for RefineSettings {
     fn default() -> Self {
         RefineSettings {
-            defect_tol_m: 3.0,
+            // 6 m: on the 15 canonical scenarios (seeds 1-5) the refined meshes are
+            // smaller than at 3 m and the plans 1-5 % faster; judged, the costs and the
+            // final misses stay within their limits (docs/BENCHMARKS.md).
+            defect_tol_m: 6.0,
             max_split: 4,
             max_intervals_per_phase: 64,
         }
