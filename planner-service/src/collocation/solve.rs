@@ -70,6 +70,9 @@ pub struct NlpSettings {
     /// point is a minimum, and leaves along negative curvature if not. 3-25 ms per solve
     /// on the canonical scenarios.
     pub second_order_check: bool,
+    /// The line search's second-order corrections (Ipopt `max_soc`: up to 4 per
+    /// iteration when a trial step is rejected; `false`: none).
+    pub second_order_corrections: bool,
     /// The linear solver of the KKT systems: FERAL, or block elimination along the chain
     /// of mesh intervals ([`super::kkt`]; FERAL where the structure does not hold). The
     /// restoration phase keeps FERAL either way. Structured by default: on the canonical
@@ -106,6 +109,7 @@ impl Default for NlpSettings {
             feral_static_pivoting: false,
             feral_pivtol: None,
             second_order_check: true,
+            second_order_corrections: true,
             kkt: KktSolver::Structured,
             mu_init: None,
             refine_mu_init: 1e-3,
@@ -469,6 +473,9 @@ fn application(
     }
     if !settings.second_order_check {
         int(o, "neg_curv_escapes", 0)?;
+    }
+    if !settings.second_order_corrections {
+        int(o, "max_soc", 0)?;
     }
     if let Some(mu) = settings.mu_init {
         num(o, "mu_init", mu)?;
