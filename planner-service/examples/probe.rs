@@ -10,7 +10,7 @@
 //! duplicate and gap tolerances),
 //! `PROBE_NLP="name=value;name=value"` (extra solver options; `PROBE_RANK_NLP` and
 //! `PROBE_FINAL_NLP` for the ranking or the working-mesh solves only, `PROBE_FIN_NLP` for the
-//! finalists' only); `PROBE_FIN_TOL`, `PROBE_FIN_ACC`, `PROBE_FIN_SOC=0|1` (the finalists'
+//! finalists' only, `PROBE_REF_NLP` for the refined solves only); `PROBE_FIN_TOL`, `PROBE_FIN_ACC`, `PROBE_FIN_SOC=0|1` (the finalists'
 //! tolerance, acceptable tolerance, second-order check); `PROBE_FIRST_SEED` (1);
 //! `PROBE_KKT=feral|structured` (the KKT linear solver of every NLP solve);
 //! `PROBE_SOC=0|1` and `PROBE_TOL` (the second-order check and the tolerance of the
@@ -124,6 +124,13 @@ fn main() {
             if let Some((k, v)) = kv.split_once('=') {
                 s.nlp.extra.push((k.to_string(), v.to_string()));
                 s.finalist_nlp.extra.push((k.to_string(), v.to_string()));
+            }
+        }
+    }
+    if let Ok(extra) = std::env::var("PROBE_REF_NLP") {
+        for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
+            if let Some((k, v)) = kv.split_once('=') {
+                s.nlp.extra.push((k.to_string(), v.to_string()));
             }
         }
     }

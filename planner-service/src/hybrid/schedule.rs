@@ -8,7 +8,8 @@
 //! refined (or polished) in a *round*. Run step by step, one core idles while the last
 //! solve of a step ends (the solves differ in length by a factor of three). Here an idle
 //! thread runs, speculatively, the solve the decision will most likely ask for: the
-//! final of the best start ranked so far, the round of the best finalist solved so far.
+//! final of the best start ranked so far, the round of the best finalist solved so far
+//! (while the last ranks run too).
 //! A decision is still taken only once its step is complete, every task's result is a
 //! function of its own inputs alone, and a speculative task that the decision did not
 //! ask for is cancelled and its result dropped: the plan is the same, byte for byte, as
@@ -162,9 +163,12 @@ impl<S: Stage> Shared<S> {
             if chosen.is_empty() {
                 chosen.push(stage.fallback());
             }
-            for (c, cancel) in self.cancel_final.iter().enumerate() {
+            for (c, (cancel_final, cancel_round)) in
+                self.cancel_final.iter().zip(&self.cancel_round).enumerate()
+            {
                 if !chosen.contains(&c) {
-                    cancel.store(true, Ordering::Relaxed);
+                    cancel_final.store(true, Ordering::Relaxed);
+                    cancel_round.store(true, Ordering::Relaxed);
                 }
             }
             board.chosen = Some(chosen);
@@ -206,15 +210,19 @@ impl<S: Stage> Shared<S> {
             }
             return None;
         }
-        // 7. Speculative: the final of the best start ranked so far.
         if stage.expired() {
             return None;
         }
-        stage
-            .finalists(&self.done_ranks(board))
-            .into_iter()
-            .find(|&c| board.finals[c] == State::Idle)
-            .map(Task::Final)
+        let so_far = stage.finalists(&self.done_ranks(board));
+        // 7. Speculative: the final of the best start ranked so far.
+        if let Some(&c) = so_far.iter().find(|&&c| board.finals[c] == State::Idle) {
+            return Some(Task::Final(c));
+        }
+        // 8. Speculative: the round of the best final so far among them (a long last
+        //    rank would otherwise leave this thread idle).
+        self.best_final(board, &so_far, stage)
+            .filter(|&(k, round)| round && board.rounds[so_far[k]] == State::Idle)
+            .map(|(k, _)| Task::Round(so_far[k]))
     }
 
     fn run(&self, stage: &S, task: Task) {
@@ -346,8 +354,10 @@ mod tests {
         /// Solves started (speculative ones included) and cancelled.
         started: AtomicUsize,
         cancelled: AtomicUsize,
-        /// When each final started (fake clock).
+        /// When each final and each round started (fake clock).
         final_started: Mutex<Vec<(usize, Duration)>>,
+        round_started: Mutex<Vec<(usize, Duration)>>,
+        round_len: u64,
         clock: std::time::Instant,
     }
 
@@ -364,6 +374,8 @@ mod tests {
                 started: AtomicUsize::new(0),
                 cancelled: AtomicUsize::new(0),
                 final_started: Mutex::new(Vec::new()),
+                round_started: Mutex::new(Vec::new()),
+                round_len: 4,
                 clock: std::time::Instant::now(),
             }
         }
@@ -423,7 +435,8 @@ mod tests {
 
         fn round(&self, c: usize, f: &Self::Final, cancel: Arc<AtomicBool>) -> Self::Round {
             assert_eq!(c, f.0);
-            (c, self.spin(4, Some(&cancel)))
+            self.round_started.lock().unwrap().push((c, self.now()));
+            (c, self.spin(self.round_len, Some(&cancel)))
         }
 
         fn expired(&self) -> bool {
@@ -443,6 +456,18 @@ mod tests {
         )
     }
 
+    /// The stage `fake()` run on one thread and on two, which decide alike.
+    fn one_and_two_threads(
+        fake: impl Fn() -> Fake,
+    ) -> (Fake, Schedule<Fake>, Fake, Schedule<Fake>) {
+        let one = fake();
+        let sequential = run(&one, 1);
+        let two = fake();
+        let parallel = run(&two, 2);
+        assert_eq!(decisions(&sequential), decisions(&parallel));
+        (one, sequential, two, parallel)
+    }
+
     #[test]
     fn two_threads_decide_as_one_and_speculate_into_idle_time() {
         // Start 3 is long: while it runs, the other thread is idle on a step-by-step
@@ -455,11 +480,7 @@ mod tests {
                 &[Some(3.0), Some(2.5), None, Some(1.0), Some(2.0), Some(9.0)],
             )
         };
-        let one = fake();
-        let sequential = run(&one, 1);
-        let two = fake();
-        let parallel = run(&two, 2);
-        assert_eq!(decisions(&sequential), decisions(&parallel));
+        let (one, sequential, two, parallel) = one_and_two_threads(fake);
         // Ranked 2 (4.0) then 0 (5.0): 2's final is refused, 0 wins and is refined.
         assert_eq!(parallel.chosen, [2, 0]);
         assert_eq!(parallel.winner, Some(1));
@@ -492,6 +513,57 @@ mod tests {
         assert_eq!(s.winner, Some(0));
         assert_eq!(s.finals, [Some((4, Some(4.0))), Some((0, Some(5.0)))]);
         assert!(slow.cancelled.load(Ordering::Relaxed) >= 1);
+    }
+
+    #[test]
+    fn a_long_last_rank_leaves_time_for_the_round_of_the_best_final() {
+        // Start 3 ranks for 60 ms. Meanwhile the other thread solves the finals of the
+        // two best ranked so far (2, then 0) and then, speculatively, the round of the
+        // better of them (2), which the decision takes: no thread waits for the rank.
+        let fake = || {
+            Fake::new(
+                &[5.0, 7.0, 4.0, 9.0, 6.0],
+                &[2, 2, 2, 60, 2],
+                &[
+                    Some(3.0),
+                    Some(2.5),
+                    Some(1.0),
+                    Some(1.5),
+                    Some(2.0),
+                    Some(9.0),
+                ],
+            )
+        };
+        let (one, sequential, two, parallel) = one_and_two_threads(fake);
+        assert_eq!(parallel.chosen, [2, 0]);
+        assert_eq!(parallel.winner, Some(0));
+        assert_eq!(parallel.round, Some((2, true)));
+        let rounds = two.round_started.lock().unwrap().clone();
+        assert_eq!(rounds.len(), 1, "{rounds:?}");
+        assert_eq!(rounds[0].0, 2);
+        assert!(rounds[0].1 < parallel.ranked_at, "{rounds:?}");
+        // One thread refines only after the ranking.
+        assert!(one.round_started.lock().unwrap()[0].1 >= sequential.ranked_at);
+    }
+
+    #[test]
+    fn a_speculative_round_of_a_start_not_chosen_is_cancelled() {
+        // While start 4 ranks (40 ms), start 1 is the best ranked so far: its final is
+        // solved and its (long) round started. Start 4 then ranks best and 0 second, so
+        // 1 is no finalist: its round is cancelled, and the round taken is the winner's.
+        let mut fake = Fake::new(
+            &[2.0, 3.0, 8.0, 8.0, 1.0],
+            &[1, 1, 1, 1, 40],
+            &[Some(5.0), Some(0.1), Some(5.0), Some(5.0), Some(4.0), None],
+        );
+        fake.round_len = 400;
+        let s = run(&fake, 2);
+        assert_eq!(s.chosen, [4, 0]);
+        assert_eq!(s.winner, Some(0));
+        let rounds = fake.round_started.lock().unwrap().clone();
+        assert!(rounds.iter().any(|r| r.0 == 1), "{rounds:?}");
+        assert!(fake.cancelled.load(Ordering::Relaxed) >= 1);
+        assert_eq!(s.round, Some((4, true)));
     }
 
     #[test]
