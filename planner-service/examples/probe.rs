@@ -4,7 +4,7 @@
 //!
 //! `cargo run --release -p wingman-planner --example probe -- [NAME-FILTER] [RUNS]`
 //!
-//! Overrides: `PROBE_SW_ITERS`, `PROBE_SW_STALL`, `PROBE_SW_PARTICLES` (the swarm's), `PROBE_STARTS`, `PROBE_FINALISTS`, `PROBE_ROUNDS`, `PROBE_RANK_PTS`,
+//! Overrides: `PROBE_SW_ITERS`, `PROBE_SW_STALL`, `PROBE_SW_PARTICLES`, `PROBE_SW_THREADS` (the swarm's), `PROBE_STARTS`, `PROBE_FINALISTS`, `PROBE_ROUNDS`, `PROBE_RANK_PTS`,
 //! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`, `PROBE_DEFECT_TOL`
 //! (the refinement's tolerance, m), `PROBE_DUP_TOL` and `PROBE_GAP_TOL` (the finalists'
 //! duplicate and gap tolerances),
@@ -50,6 +50,9 @@ fn main() {
     }
     if let Some(v) = env("PROBE_SW_STALL") {
         s.swarm.stall_iterations = v;
+    }
+    if let Some(v) = env("PROBE_SW_THREADS") {
+        s.swarm.threads = v;
     }
     if let Some(v) = env("PROBE_SW_PARTICLES") {
         s.swarm.particles = v;
@@ -175,6 +178,7 @@ fn main() {
             .and_then(|c| c.as_float())
             .unwrap_or(f64::NAN);
         let mut times = Vec::new();
+        let mut swarm_times = Vec::new();
         let mut line = String::new();
         let mut ratios = Vec::new();
         // One planner per scenario, as the service keeps one: its workspace and its
@@ -216,6 +220,7 @@ fn main() {
             let ratio = out.cost / reference;
             ratios.push(ratio);
             times.push(out.times.total.as_secs_f64() * 1e3);
+            swarm_times.push(out.times.swarm.as_secs_f64() * 1e3);
             if std::env::var("PROBE_RANKING").is_ok() {
                 let best = out
                     .nlp
@@ -265,10 +270,12 @@ fn main() {
         times.sort_by(f64::total_cmp);
         let max_ratio = ratios.iter().cloned().fold(0.0, f64::max);
         worst = worst.max(max_ratio);
+        swarm_times.sort_by(f64::total_cmp);
         println!(
-            "{name:<36} med {:7.1} ms max {:7.1} | cost/ref max {:.5} [{}] | {line}",
+            "{name:<36} med {:7.1} ms max {:7.1} swarm med {:5.1} | cost/ref max {:.5} [{}] | {line}",
             times[times.len() / 2],
             times[times.len() - 1],
+            swarm_times[swarm_times.len() / 2],
             max_ratio,
             ratios
                 .iter()
