@@ -31,6 +31,16 @@ fn env<T: std::str::FromStr>(name: &str) -> Option<T> {
     std::env::var(name).ok().and_then(|v| v.parse().ok())
 }
 
+/// The solver options `name=value;name=value` of environment variable `name`.
+fn extra_options(name: &str) -> Vec<(String, String)> {
+    std::env::var(name)
+        .unwrap_or_default()
+        .split(';')
+        .filter_map(|kv| kv.split_once('='))
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect()
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let filter = args.get(1).cloned().unwrap_or_default();
@@ -113,37 +123,15 @@ fn main() {
         s.finalist_nlp.kkt = kkt;
         s.ranking_nlp.kkt = kkt;
     }
-    if let Ok(extra) = std::env::var("PROBE_NLP") {
-        for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
-            if let Some((k, v)) = kv.split_once('=') {
-                s.nlp.extra.push((k.to_string(), v.to_string()));
-                s.finalist_nlp.extra.push((k.to_string(), v.to_string()));
-                s.ranking_nlp.extra.push((k.to_string(), v.to_string()));
-            }
-        }
-    }
-    if let Ok(extra) = std::env::var("PROBE_FINAL_NLP") {
-        for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
-            if let Some((k, v)) = kv.split_once('=') {
-                s.nlp.extra.push((k.to_string(), v.to_string()));
-                s.finalist_nlp.extra.push((k.to_string(), v.to_string()));
-            }
-        }
-    }
-    if let Ok(extra) = std::env::var("PROBE_REF_NLP") {
-        for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
-            if let Some((k, v)) = kv.split_once('=') {
-                s.nlp.extra.push((k.to_string(), v.to_string()));
-            }
-        }
-    }
-    if let Ok(extra) = std::env::var("PROBE_FIN_NLP") {
-        for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
-            if let Some((k, v)) = kv.split_once('=') {
-                s.finalist_nlp.extra.push((k.to_string(), v.to_string()));
-            }
-        }
-    }
+    s.nlp.extra.extend(extra_options("PROBE_NLP"));
+    s.finalist_nlp.extra.extend(extra_options("PROBE_NLP"));
+    s.ranking_nlp.extra.extend(extra_options("PROBE_NLP"));
+    s.nlp.extra.extend(extra_options("PROBE_FINAL_NLP"));
+    s.finalist_nlp
+        .extra
+        .extend(extra_options("PROBE_FINAL_NLP"));
+    s.nlp.extra.extend(extra_options("PROBE_REF_NLP"));
+    s.finalist_nlp.extra.extend(extra_options("PROBE_FIN_NLP"));
     if let Some(v) = env::<u8>("PROBE_SOC") {
         s.nlp.second_order_check = v != 0;
     }
@@ -159,13 +147,7 @@ fn main() {
     if let Some(v) = env::<u8>("PROBE_FIN_SOC") {
         s.finalist_nlp.second_order_check = v != 0;
     }
-    if let Ok(extra) = std::env::var("PROBE_RANK_NLP") {
-        for kv in extra.split(';').filter(|kv| !kv.is_empty()) {
-            if let Some((k, v)) = kv.split_once('=') {
-                s.ranking_nlp.extra.push((k.to_string(), v.to_string()));
-            }
-        }
-    }
+    s.ranking_nlp.extra.extend(extra_options("PROBE_RANK_NLP"));
     let mut worst = 0.0f64;
     for (name, _) in BUNDLED {
         if !name.contains(filter.as_str()) {

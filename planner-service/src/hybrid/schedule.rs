@@ -202,13 +202,10 @@ impl<S: Stage> Shared<S> {
                     .map(Task::Round);
             }
             // 6. Speculative: the round of the best final so far.
-            if !stage.expired()
-                && let Some((k, true)) = self.best_final(board, &chosen, stage)
-                && board.rounds[chosen[k]] == State::Idle
-            {
-                return Some(Task::Round(chosen[k]));
+            if stage.expired() {
+                return None;
             }
-            return None;
+            return self.speculative_round(board, &chosen, stage);
         }
         if stage.expired() {
             return None;
@@ -220,9 +217,15 @@ impl<S: Stage> Shared<S> {
         }
         // 8. Speculative: the round of the best final so far among them (a long last
         //    rank would otherwise leave this thread idle).
-        self.best_final(board, &so_far, stage)
-            .filter(|&(k, round)| round && board.rounds[so_far[k]] == State::Idle)
-            .map(|(k, _)| Task::Round(so_far[k]))
+        self.speculative_round(board, &so_far, stage)
+    }
+
+    /// The round of the best accepted final among `candidates` that are done, if it
+    /// wants one and it is not started.
+    fn speculative_round(&self, board: &Board, candidates: &[usize], stage: &S) -> Option<Task> {
+        self.best_final(board, candidates, stage)
+            .filter(|&(k, round)| round && board.rounds[candidates[k]] == State::Idle)
+            .map(|(k, _)| Task::Round(candidates[k]))
     }
 
     fn run(&self, stage: &S, task: Task) {
