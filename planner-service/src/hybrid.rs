@@ -587,7 +587,7 @@ impl Planner {
     pub fn new(settings: &PlannerSettings) -> Planner {
         Planner {
             swarm: SwarmWorkspace::new(&settings.swarm),
-            timing: [SolveTiming::default(); 2],
+            timing: [SolveTiming::prior(false), SolveTiming::prior(true)],
         }
     }
 
@@ -641,6 +641,10 @@ impl Planner {
             ranking: Vec::new(),
             finalists: Vec::new(),
         };
+        // No time left for one solve's set-up and wrap-up (as recent plans measured
+        // them): no NLP stage at all, not even its starts (2-3 ms of dense costs).
+        let timing = self.timing[model];
+        let no_time = deadline.remaining() <= timing.setup + timing.wrap_up;
         // Starts from distinct basins, solved side by side on the first mesh.
         // The swarm's workspace holds this problem's seeds: no need to build them again.
         let count = if deadline.expired() {
@@ -648,9 +652,13 @@ impl Planner {
         } else {
             settings.starts.max(1)
         };
-        let starts = basins::candidates(problem, &sw.best, self.swarm.seeds(), count, |tr| {
-            trajectory_cost(problem, tr)
-        });
+        let starts = if no_time {
+            Vec::new()
+        } else {
+            basins::candidates(problem, &sw.best, self.swarm.seeds(), count, |tr| {
+                trajectory_cost(problem, tr)
+            })
+        };
         // Rank every start on the coarse mesh, solve the best distinct ones on the working
         // mesh, refine the best of those: scheduled on the planner's threads (`schedule`).
         let rank = if problem.dim() == 3 {
@@ -680,11 +688,15 @@ impl Planner {
                 max_step_s: settings.export.max_step_s / 2.0,
                 ..settings.export
             },
-            timing: self.timing[model],
+            timing,
             seen: Seen::default(),
             deadline,
         };
-        let done = schedule::run(&stage, settings.threads);
+        let done = if no_time {
+            schedule::Schedule::none()
+        } else {
+            schedule::run(&stage, settings.threads)
+        };
         times.ranking = done.ranked_at.saturating_sub(nlp_started);
         report.finalists = done.chosen;
         // The report and any error in the step-by-step order: ranks, finals, rounds. A

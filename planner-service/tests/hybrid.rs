@@ -1,10 +1,11 @@
 //! The hybrid planner's contract: same input and seed give the same plan bit for bit; a
 //! deadline too short for the NLP still returns a finite, flyable plan flagged
-//! `SwarmOnly` or `Feasible`; bad input is an error, not a panic.
+//! `SwarmOnly` or `Feasible`; a fresh planner starts no NLP solve it has no time to set
+//! up; bad input is an error, not a panic.
 
 use std::time::Duration;
 use wingman_interfaces::Quality;
-use wingman_planner::clock::{Deadline, MonotonicClock};
+use wingman_planner::clock::{Deadline, ManualClock, MonotonicClock};
 use wingman_planner::hybrid::{Planner, PlannerSettings};
 use wingman_planner::problem::Problem;
 use wingman_planner::scenario::bundled;
@@ -101,6 +102,47 @@ fn a_deadline_too_short_for_the_nlp_still_gives_a_flyable_plan() {
                 "{name}: state {c}"
             );
         }
+    }
+}
+
+#[test]
+fn a_fresh_planner_starts_no_solve_it_has_no_time_to_set_up() {
+    // The clock stands still: only the budget left at the NLP decides, not the time the
+    // swarm takes. A fresh planner has measured no solve yet; it must not start one
+    // blind with less time than a solve's set-up and wrap-up (before the prior estimate,
+    // a fresh 2-D planner under a 5 ms budget started its solves and returned after
+    // 10.7 ms). With a long budget the same planner solves.
+    let clock: &'static ManualClock = Box::leak(Box::new(ManualClock::new()));
+    for name in ["2d-min-time-avoidable", "3d-min-time-rendezvous-avoidable"] {
+        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+        let settings = PlannerSettings::default();
+        let mut planner = Planner::new(&settings);
+        let out = planner
+            .plan(
+                &problem,
+                &settings,
+                Deadline::after(clock, Duration::from_millis(2)),
+            )
+            .unwrap();
+        assert_eq!(out.quality, Quality::SwarmOnly, "{name}");
+        assert!(
+            out.nlp.iterations.is_empty() && out.nlp.ranking.is_empty(),
+            "{name}: no solve may run, no start be built: {:?}",
+            out.nlp
+        );
+        assert!(out.trajectory.is_valid() && out.cost.is_finite(), "{name}");
+        let out = planner
+            .plan(
+                &problem,
+                &settings,
+                Deadline::after(clock, Duration::from_secs(1)),
+            )
+            .unwrap();
+        assert_eq!(
+            out.quality,
+            Quality::Optimal,
+            "{name}: with time, it solves"
+        );
     }
 }
 

@@ -68,6 +68,20 @@ pub(super) struct Schedule<S: Stage> {
     pub ranked_at: Duration,
 }
 
+impl<S: Stage> Schedule<S> {
+    /// The schedule that ran nothing (no time for it): no rank, no final, no winner.
+    pub fn none() -> Schedule<S> {
+        Schedule {
+            ranks: Vec::new(),
+            chosen: Vec::new(),
+            finals: Vec::new(),
+            winner: None,
+            round: None,
+            ranked_at: Duration::ZERO,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum State {
     Idle,

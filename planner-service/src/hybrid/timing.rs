@@ -19,6 +19,30 @@ pub(super) struct SolveTiming {
 }
 
 impl SolveTiming {
+    /// The estimate of a planner that has not solved yet (`three_d`: of the 3-D model):
+    /// about the longest set-up, iteration and wrap-up of the canonical scenarios' solves
+    /// on the slower of the hosts measured (a 2.3 GHz Xeon VM, 2026-12-03: 2-D set-up
+    /// 2.2-5.2 ms, 3.4-16 us per variable, wrap-up 0.8-1.5 ms; 3-D 5.5-14 ms, 5-15 us,
+    /// 3.8-10 ms). Without it the first plan starts its solves blind: under a 5 ms budget
+    /// a fresh 2-D planner returned after 10.7 ms. A faster host replaces it after the
+    /// first plan that solves (see [`SolveTiming::after`]); a plan that may start no solve
+    /// lowers it by a tenth.
+    pub fn prior(three_d: bool) -> SolveTiming {
+        if three_d {
+            SolveTiming {
+                setup: Duration::from_millis(12),
+                per_var: 12e-6,
+                wrap_up: Duration::from_millis(6),
+            }
+        } else {
+            SolveTiming {
+                setup: Duration::from_millis(5),
+                per_var: 8e-6,
+                wrap_up: Duration::from_micros(1500),
+            }
+        }
+    }
+
     /// The longer of each.
     pub fn max(self, other: SolveTiming) -> SolveTiming {
         SolveTiming {
