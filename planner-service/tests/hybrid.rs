@@ -14,6 +14,14 @@ fn clock() -> &'static MonotonicClock {
     Box::leak(Box::new(MonotonicClock::new()))
 }
 
+/// A bundled scenario's problem, the default settings and a new planner.
+fn fresh(name: &str) -> (Problem, PlannerSettings, Planner) {
+    let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+    let settings = PlannerSettings::default();
+    let planner = Planner::new(&settings);
+    (problem, settings, planner)
+}
+
 fn bits(tr: &wingman_planner::trajectory::Trajectory) -> Vec<u64> {
     let mut out: Vec<u64> = tr.times.iter().map(|v| v.to_bits()).collect();
     out.extend(tr.states.iter().flatten().map(|v| v.to_bits()));
@@ -74,9 +82,7 @@ fn same_input_and_seed_give_the_same_plan_bit_for_bit() {
 #[test]
 fn a_deadline_too_short_for_the_nlp_still_gives_a_flyable_plan() {
     for name in ["2d-min-time-avoidable", "3d-min-time-rendezvous-avoidable"] {
-        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
-        let settings = PlannerSettings::default();
-        let mut planner = Planner::new(&settings);
+        let (problem, settings, mut planner) = fresh(name);
         let out = planner
             .plan(
                 &problem,
@@ -114,9 +120,7 @@ fn a_fresh_planner_starts_no_solve_it_has_no_time_to_set_up() {
     // 10.7 ms). With a long budget the same planner solves.
     let clock: &'static ManualClock = Box::leak(Box::new(ManualClock::new()));
     for name in ["2d-min-time-avoidable", "3d-min-time-rendezvous-avoidable"] {
-        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
-        let settings = PlannerSettings::default();
-        let mut planner = Planner::new(&settings);
+        let (problem, settings, mut planner) = fresh(name);
         let out = planner
             .plan(
                 &problem,
