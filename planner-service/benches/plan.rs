@@ -7,6 +7,9 @@
 //! The peak heap is counted in a pass of its own (the same plans again), not in the
 //! timed runs: the counting allocator's shared counters, updated by both threads at
 //! every allocation of the solver, cost the timed plans up to 15 %.
+//!
+//! The last column times a fixed workload (`host_reference_ms`) just before and just after
+//! each scenario's timed plans: the host's speed while they ran.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicIsize, Ordering};
@@ -55,6 +58,70 @@ fn peak_of(run: impl FnOnce()) -> isize {
 #[global_allocator]
 static GLOBAL: Peak = Peak;
 
+/// The host's speed now: a fixed workload (400 dense Bunch–Kaufman factorisations of one
+/// 72 × 72 KKT-shaped block, the planner's hottest kernel) run on two threads at once, as
+/// the planner runs; the slower thread's median of three timings, in ms. Timed before and
+/// after each scenario, so that its plan times can be read against the speed the host had
+/// while they ran (a shared VM's speed swings by up to 1.8× within minutes;
+/// docs/BENCHMARKS.md).
+fn host_reference_ms() -> f64 {
+    std::thread::scope(|s| {
+        let other = s.spawn(reference_workload_ms);
+        let here = reference_workload_ms();
+        here.max(other.join().expect("the reference workload does not panic"))
+    })
+}
+
+/// One thread's part of [`host_reference_ms`].
+fn reference_workload_ms() -> f64 {
+    use wingman_planner::collocation::bunch_kaufman as bk;
+    const N: usize = 72;
+    const PRIMAL: usize = 42;
+    // Primal rows: a positive diagonal with 6 × 6 node blocks; dual rows: coupled to
+    // every third primal column, a tiny negative diagonal (an indefinite saddle point).
+    let mut k = vec![0.0; N * N];
+    for i in 0..N {
+        for j in 0..=i {
+            let v = if i < PRIMAL {
+                if i == j {
+                    1.5 + 0.5 * (i as f64).sin()
+                } else if i / 6 == j / 6 {
+                    0.2 * ((i * 7 + j * 3) as f64).sin()
+                } else {
+                    0.0
+                }
+            } else if j < PRIMAL {
+                if (i + j) % 3 == 0 {
+                    ((i * 5 + j) as f64).cos()
+                } else {
+                    0.0
+                }
+            } else if i == j {
+                -1e-8
+            } else {
+                0.0
+            };
+            k[i + j * N] = v;
+        }
+    }
+    let mut a = k.clone();
+    let mut piv = vec![0i32; N];
+    let mut work = vec![0.0; bk::work_len(N)];
+    let mut times: Vec<f64> = (0..3)
+        .map(|_| {
+            let began = std::time::Instant::now();
+            for _ in 0..400 {
+                a.copy_from_slice(&k);
+                std::hint::black_box(bk::factor(&mut a, N, &mut piv, &mut work))
+                    .expect("the reference block is nonsingular");
+            }
+            began.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[1]
+}
+
 fn percentile(sorted: &[f64], p: f64) -> f64 {
     let k = ((sorted.len() as f64 - 1.0) * p).round() as usize;
     sorted[k.min(sorted.len() - 1)]
@@ -76,9 +143,9 @@ fn main() {
     let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
     let settings = PlannerSettings::default();
     println!(
-        "| scenario | median ms | p95 ms | swarm % | NLP % | of it ranking % | rest % | cost min | cost max | spread % | peak heap MiB | quality |"
+        "| scenario | median ms | p95 ms | swarm % | NLP % | of it ranking % | rest % | cost min | cost max | spread % | peak heap MiB | quality | host ref ms |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|");
     for (name, _) in BUNDLED {
         if only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
             continue;
@@ -88,6 +155,7 @@ fn main() {
         let (mut swarm, mut nlp, mut ranking, mut total) = (0.0, 0.0, 0.0, 0.0);
         let mut costs = Vec::new();
         let mut qualities = std::collections::BTreeMap::new();
+        let reference_before = host_reference_ms();
         for seed in 1..=runs {
             let s = PlannerSettings {
                 swarm: settings.swarm.clone().with_seed(seed),
@@ -110,6 +178,7 @@ fn main() {
             costs.push(out.cost);
             *qualities.entry(format!("{:?}", out.quality)).or_insert(0) += 1;
         }
+        let reference_after = host_reference_ms();
         // The peak heap over the same plans, untimed.
         let peak = peak_of(|| {
             for seed in 1..=runs {
@@ -131,7 +200,7 @@ fn main() {
         costs.sort_by(f64::total_cmp);
         let (lo, hi) = (costs[0], costs[costs.len() - 1]);
         println!(
-            "| {name} | {:.1} | {:.1} | {:.0} | {:.0} | {:.0} | {:.0} | {lo:.6} | {hi:.6} | {:.3} | {peak:.1} | {} |",
+            "| {name} | {:.1} | {:.1} | {:.0} | {:.0} | {:.0} | {:.0} | {lo:.6} | {hi:.6} | {:.3} | {peak:.1} | {} | {reference_before:.1} / {reference_after:.1} |",
             percentile(&times, 0.5),
             percentile(&times, 0.95),
             100.0 * swarm / total,
