@@ -322,7 +322,7 @@ fn solve_on_mesh(
         start_x,
         cancel,
     } = job;
-    if deadline.remaining() <= timing.setup + timing.wrap_up {
+    if !timing.fits_a_solve(deadline.remaining()) {
         // No time for even one iteration (the longest set-up and first iteration of
         // recent solves): do not build the NLP; the caller returns what it has.
         return Ok((None, 0, NlpStatus::MaxTime, SolveTiming::default()));
@@ -643,18 +643,15 @@ impl Planner {
         };
         // No time left for one solve's set-up and wrap-up (as recent plans measured
         // them): no NLP stage at all, not even its starts (2-3 ms of dense costs).
+        // (An expired deadline is one of these.)
         let timing = self.timing[model];
-        let no_time = deadline.remaining() <= timing.setup + timing.wrap_up;
+        let no_time = !timing.fits_a_solve(deadline.remaining());
         // Starts from distinct basins, solved side by side on the first mesh.
         // The swarm's workspace holds this problem's seeds: no need to build them again.
-        let count = if deadline.expired() {
-            1
-        } else {
-            settings.starts.max(1)
-        };
         let starts = if no_time {
             Vec::new()
         } else {
+            let count = settings.starts.max(1);
             basins::candidates(problem, &sw.best, self.swarm.seeds(), count, |tr| {
                 trajectory_cost(problem, tr)
             })

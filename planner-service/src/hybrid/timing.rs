@@ -43,6 +43,11 @@ impl SolveTiming {
         }
     }
 
+    /// Whether `remaining` leaves time for one solve: its set-up and its wrap-up.
+    pub fn fits_a_solve(&self, remaining: Duration) -> bool {
+        remaining > self.setup + self.wrap_up
+    }
+
     /// The longer of each.
     pub fn max(self, other: SolveTiming) -> SolveTiming {
         SolveTiming {
@@ -171,5 +176,25 @@ mod tests {
         assert_eq!(idle.setup, ms(8).mul_f64(0.9));
         assert!((idle.per_var - 1.8e-6).abs() < 1e-18);
         assert_eq!(idle.wrap_up, ms(2).mul_f64(0.9));
+    }
+
+    #[test]
+    fn a_solve_fits_only_past_its_set_up_and_wrap_up() {
+        let t = SolveTiming {
+            setup: ms(5),
+            per_var: 1e-6,
+            wrap_up: ms(2),
+        };
+        assert!(
+            !t.fits_a_solve(Duration::ZERO),
+            "an expired deadline fits none"
+        );
+        assert!(!t.fits_a_solve(ms(7)));
+        assert!(t.fits_a_solve(ms(7) + Duration::from_nanos(1)));
+        // Each prior leaves a short budget without a solve, a long one with.
+        for three_d in [false, true] {
+            let p = SolveTiming::prior(three_d);
+            assert!(!p.fits_a_solve(ms(2)) && p.fits_a_solve(ms(100)));
+        }
     }
 }
