@@ -27,7 +27,7 @@ use crate::collocation::{
 use crate::problem::Problem;
 use crate::swarm::{self, SwarmOutcome, SwarmSettings, SwarmWorkspace};
 use crate::trajectory::Trajectory;
-use timing::{Seen, SolveTiming};
+use timing::{Ranking, Seen, SolveTiming, StageTiming};
 
 /// How each phase's first mesh is cut.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -264,6 +264,9 @@ pub struct Planner {
     /// Per model (2-D, 3-D): about the longest set-up, iteration and wrap-up of the NLP
     /// solves of recent plans, to keep the deadline.
     timing: [SolveTiming; 2],
+    /// Per model: how long recent plans' ranking and fallback took, to decide whether a
+    /// budget can hold the NLP stage at all.
+    stage: [StageTiming; 2],
 }
 
 /// One NLP solve's accepted result.
@@ -588,6 +591,7 @@ impl Planner {
         Planner {
             swarm: SwarmWorkspace::new(&settings.swarm),
             timing: [SolveTiming::prior(false), SolveTiming::prior(true)],
+            stage: [StageTiming::prior(false), StageTiming::prior(true)],
         }
     }
 
@@ -609,7 +613,21 @@ impl Planner {
         let started = clock.now();
         let mut times = StageTimes::default();
 
-        let swarm_deadline = deadline.share(settings.swarm_share);
+        let model = usize::from(problem.dim() == 3);
+        let (timing, stage_timing) = (self.timing[model], self.stage[model]);
+        // The NLP stage only when the budget left after the swarm's share (and the
+        // fallback's reserve) can hold it, as recent plans took it: it yields nothing before
+        // its ranking is done. Otherwise the swarm has all of the budget but the reserve.
+        let share = settings.swarm_share.clamp(0.0, 1.0);
+        let reserve = stage_timing.fallback * 2;
+        let after_swarm = deadline.remaining().mul_f64(1.0 - share);
+        let nlp_possible =
+            stage_timing.fits_the_stage(&timing, after_swarm.saturating_sub(reserve));
+        let swarm_deadline = if nlp_possible {
+            deadline.share(share)
+        } else {
+            deadline.earlier(reserve)
+        };
         let sw: SwarmOutcome =
             swarm::run(problem, &settings.swarm, &mut self.swarm, swarm_deadline)?;
         times.swarm = sw.elapsed;
@@ -632,7 +650,6 @@ impl Planner {
         let deadline = deadline.earlier(fallback_cost * 2);
 
         let nlp_started = clock.now();
-        let model = usize::from(problem.dim() == 3);
         let mut report = NlpReport {
             status: None,
             iterations: Vec::new(),
@@ -641,11 +658,10 @@ impl Planner {
             ranking: Vec::new(),
             finalists: Vec::new(),
         };
-        // No time left for one solve's set-up and wrap-up (as recent plans measured
-        // them): no NLP stage at all, not even its starts (2-3 ms of dense costs).
-        // (An expired deadline is one of these.)
-        let timing = self.timing[model];
-        let no_time = !timing.fits_a_solve(deadline.remaining());
+        // No time left for the ranking and one solve's set-up and wrap-up after it (as
+        // recent plans measured them): no NLP stage at all, not even its starts (2-3 ms of
+        // dense costs). (An expired deadline is one of these.)
+        let no_time = !nlp_possible || !stage_timing.fits_the_stage(&timing, deadline.remaining());
         // Starts from distinct basins, solved side by side on the first mesh.
         // The swarm's workspace holds this problem's seeds: no need to build them again.
         let starts = if no_time {
@@ -699,12 +715,15 @@ impl Planner {
         // The report and any error in the step-by-step order: ranks, finals, rounds. A
         // task that failed (panicked) counts as a failed solve.
         let failed = || Ok((None, 0, NlpStatus::NumericalError, SolveTiming::default()));
+        // A rank the deadline stopped: the ranking was cut short.
+        let mut cut = false;
         for r in done.ranks {
             let (path, result) = match r {
                 Some(Ranked { result, path }) => (path, result),
                 None => (None, failed()),
             };
             let (_, iterations, status, _) = result?;
+            cut |= status == NlpStatus::MaxTime;
             report.iterations.push(iterations);
             report.status = Some(status);
             report.ranking.push(path.map_or(f64::NAN, |p| p.0));
@@ -756,6 +775,12 @@ impl Planner {
         }
         times.nlp = clock.now().saturating_sub(nlp_started);
         self.timing[model] = self.timing[model].after(stage.seen.get());
+        let ranking = match (no_time, cut) {
+            (true, _) => Ranking::Skipped,
+            (false, true) => Ranking::Cut(times.ranking),
+            (false, false) => Ranking::Done(times.ranking),
+        };
+        self.stage[model] = stage_timing.after(ranking, fallback_cost);
 
         let export_started = clock.now();
         let (quality, trajectory) = match &accepted {

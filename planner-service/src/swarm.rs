@@ -104,8 +104,10 @@
 //!
 //! # Time and memory
 //!
-//! The deadline is checked before every iteration; on expiry the best so far is returned
-//! with [`SwarmStatus::MaxTime`] (with a deadline already passed: the best seed). Every
+//! The deadline is checked before every round of the particles: one starts only while it
+//! still fits (as long as the longest round so far; the first as long as scoring as many
+//! seeds), else the best so far is returned with [`SwarmStatus::MaxTime`] (with a deadline
+//! already passed: the best seed). Every
 //! buffer is allocated in [`SwarmWorkspace::new`]; a run allocates only to build the
 //! seeds, to start its worker threads and for the returned trajectories, never in the
 //! iteration loop (`tests/swarm_no_alloc.rs`).
@@ -986,14 +988,25 @@ pub fn run(
         };
 
         // Seeds: fly each, price it, rank them.
+        let seeds_started = clock.now();
         if !run_job(JOB_SEEDS) {
             return false;
         }
+        let mut scored = 0;
         for m in shards {
-            for &(i, s) in &lock(m).seed_scores {
+            let sh = lock(m);
+            scored += sh.seed_scores.len();
+            for &(i, s) in &sh.seed_scores {
                 seed_scores[i] = s;
             }
         }
+        // A round of the particles takes about as long as scoring as many seeds: the
+        // estimate of the first round (tracking the seeds onto the particles included),
+        // until one is measured.
+        let mut round = clock
+            .now()
+            .saturating_sub(seeds_started)
+            .mul_f64(settings.particles as f64 / scored.max(1) as f64);
         for (i, seed) in seeds.iter().enumerate() {
             order.push(i);
             let total = seed.arc_lengths().last().copied().unwrap_or(0.0);
@@ -1016,7 +1029,8 @@ pub fn run(
         eval::track(grid, &seeds[seeds_best], lookahead, global);
         gscore = seed_scores[seeds_best];
         history.push(gscore.cost);
-        if deadline.expired() {
+        // No time for the particles' first round: the best seed.
+        if deadline.remaining() <= round {
             status = SwarmStatus::MaxTime;
             stop();
             return true;
@@ -1101,6 +1115,7 @@ pub fn run(
             group_score[k] = group_score[0];
         }
         // Particles.
+        let first_round = clock.now();
         let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
         let mut j = 0;
         for m in shards {
@@ -1131,6 +1146,7 @@ pub fn run(
             }
         }
         let mut alive = run_job(JOB_PARTICLES);
+        round = clock.now().saturating_sub(first_round);
         // Local bests are the particles themselves; group bests (from their leaders)
         // and the global best (from the best seed) improve with them.
         let mut j = 0;
@@ -1170,10 +1186,12 @@ pub fn run(
                 status = SwarmStatus::MaxIterations;
                 break;
             }
-            if deadline.expired() {
+            // Stop while the next iteration still fits (as long as the longest so far).
+            if deadline.remaining() <= round {
                 status = SwarmStatus::MaxTime;
                 break;
             }
+            let iteration_started = clock.now();
             iterations += 1;
             // Update (eq. 4.1), random numbers in particle order; the attractor `G` is the
             // particle's group best until the merge, then the global best.
@@ -1257,6 +1275,7 @@ pub fn run(
             }
             evaluations += settings.particles;
             history.push(gscore.cost);
+            round = round.max(clock.now().saturating_sub(iteration_started));
             // A gain: the global best improved, or (before the merge) any group's best.
             let tol = settings.stall_tolerance;
             let better = |now: &Score, was: &Score| {

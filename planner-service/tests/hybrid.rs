@@ -112,29 +112,37 @@ fn a_deadline_too_short_for_the_nlp_still_gives_a_flyable_plan() {
 }
 
 #[test]
-fn a_fresh_planner_starts_no_solve_it_has_no_time_to_set_up() {
+fn a_fresh_planner_starts_no_nlp_stage_its_budget_cannot_hold() {
     // The clock stands still: only the budget left at the NLP decides, not the time the
-    // swarm takes. A fresh planner has measured no solve yet; it must not start one
-    // blind with less time than a solve's set-up and wrap-up (before the prior estimate,
-    // a fresh 2-D planner under a 5 ms budget started its solves and returned after
-    // 10.7 ms). With a long budget the same planner solves.
+    // swarm takes. A fresh planner has measured nothing yet and starts from its priors.
+    // A budget shorter than a solve's set-up and wrap-up (2 ms) starts no solve (before
+    // the prior estimate, a fresh 2-D planner under a 5 ms budget started its solves and
+    // returned after 10.7 ms). Nor does one that holds a solve's set-up and wrap-up but
+    // not the ranking (2-D 20 ms, 3-D 50 ms): the stage yields a plan only after every
+    // start is ranked (before, it started and was cut by the deadline with nothing to
+    // show). No start is built either. With a long budget the same planner solves.
     let clock: &'static ManualClock = Box::leak(Box::new(ManualClock::new()));
-    for name in ["2d-min-time-avoidable", "3d-min-time-rendezvous-avoidable"] {
+    for (name, short_ms) in [
+        ("2d-min-time-avoidable", [2, 10]),
+        ("3d-min-time-rendezvous-avoidable", [2, 40]),
+    ] {
         let (problem, settings, mut planner) = fresh(name);
-        let out = planner
-            .plan(
-                &problem,
-                &settings,
-                Deadline::after(clock, Duration::from_millis(2)),
-            )
-            .unwrap();
-        assert_eq!(out.quality, Quality::SwarmOnly, "{name}");
-        assert!(
-            out.nlp.iterations.is_empty() && out.nlp.ranking.is_empty(),
-            "{name}: no solve may run, no start be built: {:?}",
-            out.nlp
-        );
-        assert!(out.trajectory.is_valid() && out.cost.is_finite(), "{name}");
+        for budget_ms in short_ms {
+            let out = planner
+                .plan(
+                    &problem,
+                    &settings,
+                    Deadline::after(clock, Duration::from_millis(budget_ms)),
+                )
+                .unwrap();
+            assert_eq!(out.quality, Quality::SwarmOnly, "{name}");
+            assert!(
+                out.nlp.iterations.is_empty() && out.nlp.ranking.is_empty(),
+                "{name}: no stage under {budget_ms} ms: {:?}",
+                out.nlp
+            );
+            assert!(out.trajectory.is_valid() && out.cost.is_finite(), "{name}");
+        }
         let out = planner
             .plan(
                 &problem,

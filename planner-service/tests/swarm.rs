@@ -231,6 +231,23 @@ impl Clock for TickingClock {
     }
 }
 
+/// The number of seeds of `p` under `s`, and a run on a [`TickingClock`] whose budget
+/// covers the seeds (each built and each scored reads the clock once) and `extra` more
+/// readings.
+fn ticking_run(p: &Problem, s: &SwarmSettings, extra: u64) -> (u64, SwarmOutcome) {
+    let mut ws = SwarmWorkspace::new(s);
+    let seeds = run(p, s, &mut ws).seeds as u64;
+    let clock = TickingClock::default();
+    let o = swarm::run(
+        p,
+        s,
+        &mut ws,
+        Deadline::after(&clock, Duration::from_millis(2 * seeds + extra)),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    (seeds, o)
+}
+
 /// The deadline is checked every iteration: on a clock that advances 1 ms per reading, a
 /// budget that covers the seeds (each built and each scored reads the clock once) and 30
 /// more readings stops the run after some iterations with `MaxTime` and a valid best
@@ -241,16 +258,7 @@ fn a_deadline_during_the_run_stops_it() {
     let s = small()
         .with_max_iterations(1000)
         .with_stall_iterations(1000);
-    let mut ws = SwarmWorkspace::new(&s);
-    let seeds = run(&p, &s, &mut ws).seeds as u64;
-    let clock = TickingClock::default();
-    let o = swarm::run(
-        &p,
-        &s,
-        &mut ws,
-        Deadline::after(&clock, Duration::from_millis(2 * seeds + 30)),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    let (seeds, o) = ticking_run(&p, &s, 30);
     assert_eq!(o.status, SwarmStatus::MaxTime);
     assert_eq!(o.seeds as u64, seeds);
     assert!(
@@ -260,6 +268,23 @@ fn a_deadline_during_the_run_stops_it() {
     );
     assert!(o.best.is_valid());
     assert!(o.cost <= o.seeds_best_cost);
+}
+
+/// The swarm starts a round of its particles only while one still fits: on a clock that
+/// advances 1 ms per reading, a budget that leaves a few readings after the seeds (less
+/// than the first round is expected to take: as long as scoring as many seeds) returns the
+/// best seed with no iteration, instead of starting a round it would end past the
+/// deadline.
+#[test]
+fn no_round_starts_that_would_end_past_the_deadline() {
+    let p = problem("2d-min-time-avoidable");
+    let s = small().with_threads(1);
+    let (seeds, o) = ticking_run(&p, &s, 4);
+    assert_eq!(o.status, SwarmStatus::MaxTime);
+    assert_eq!(o.seeds as u64, seeds, "every seed scored");
+    assert_eq!(o.iterations, 0, "no round started");
+    assert!(o.best.is_valid());
+    assert_eq!(o.cost, o.seeds_best_cost);
 }
 
 /// A deadline too short for the seeds: the first ones are built and scored (at least

@@ -82,6 +82,77 @@ impl SolveTiming {
     }
 }
 
+/// What the planner learns of its NLP stage as a whole. The stage yields a plan only after
+/// every start is ranked and a finalist's solve has run (the finalists are chosen on all
+/// the ranks), so a budget that cannot hold the ranking is better spent on the swarm: the
+/// NLP is not started, and the swarm runs until the fallback must be built.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct StageTiming {
+    /// How long the ranking step takes (every start, on the planner's threads).
+    pub ranking: Duration,
+    /// Building the fallback: the swarm's path resampled (and in 3-D flown).
+    pub fallback: Duration,
+    /// The least the ranking estimate comes down to while no plan tries the stage: half
+    /// the prior's, so that a budget far below any ranking never tries a stage it cannot
+    /// finish.
+    floor: Duration,
+}
+
+/// How a plan's ranking step ended, for [`StageTiming::after`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Ranking {
+    /// Not started (no time for the stage).
+    Skipped,
+    /// Every start ranked, in this long.
+    Done(Duration),
+    /// Stopped by the deadline after this long.
+    Cut(Duration),
+}
+
+impl StageTiming {
+    /// The estimate of a planner that has not planned yet (`three_d`: of the 3-D model):
+    /// below the shortest rankings of the canonical scenarios (2-D 25-50 ms on a 2.6 GHz
+    /// EPYC, 40-110 ms on a 2.3 GHz Xeon VM; 3-D 55-220 ms and 90-300 ms), so that a
+    /// budget that might hold the stage tries it; the fallback about the longest seen
+    /// (2-D 0.1-0.3 ms, 3-D 1-3 ms).
+    pub fn prior(three_d: bool) -> StageTiming {
+        let (ranking, fallback) = if three_d {
+            (Duration::from_millis(50), Duration::from_millis(3))
+        } else {
+            (Duration::from_millis(20), Duration::from_micros(500))
+        };
+        StageTiming {
+            ranking,
+            fallback,
+            floor: ranking / 2,
+        }
+    }
+
+    /// Whether `remaining` (after the swarm) leaves time for the stage to yield a plan:
+    /// the ranking, then one solve's set-up and wrap-up (`solves`).
+    pub fn fits_the_stage(&self, solves: &SolveTiming, remaining: Duration) -> bool {
+        remaining > self.ranking + solves.setup + solves.wrap_up
+    }
+
+    /// The estimate after a plan whose ranking ended as `ranking` and whose fallback took
+    /// `fallback`. A ranking done: its time. One cut by the deadline: at least twice what it
+    /// had (the next tries wait until the estimate has come down again). None: a tenth
+    /// lower, down to the floor, so that a later plan tries again (a host that was slow
+    /// for a while is tried again). The fallback: the longer of this one and half the
+    /// estimate.
+    pub fn after(self, ranking: Ranking, fallback: Duration) -> StageTiming {
+        StageTiming {
+            ranking: match ranking {
+                Ranking::Skipped => self.ranking.mul_f64(0.9).max(self.floor),
+                Ranking::Done(d) => d,
+                Ranking::Cut(d) => self.ranking.max(d * 2),
+            },
+            fallback: fallback.max(self.fallback / 2),
+            floor: self.floor,
+        }
+    }
+}
+
 /// The timing seen in one plan, raised by its solves as they end (from any thread).
 #[derive(Debug, Default)]
 pub(super) struct Seen {
@@ -121,6 +192,14 @@ mod tests {
         Duration::from_millis(v)
     }
 
+    fn solves(setup_ms: u64, per_var: f64, wrap_up_ms: u64) -> SolveTiming {
+        SolveTiming {
+            setup: ms(setup_ms),
+            per_var,
+            wrap_up: ms(wrap_up_ms),
+        }
+    }
+
     #[test]
     fn seen_keeps_the_longest_of_each_from_any_thread() {
         let seen = Seen::default();
@@ -157,16 +236,8 @@ mod tests {
 
     #[test]
     fn the_estimate_forgets_slow_plans_by_halves_and_retries_after_none() {
-        let old = SolveTiming {
-            setup: ms(8),
-            per_var: 2e-6,
-            wrap_up: ms(2),
-        };
-        let seen = SolveTiming {
-            setup: ms(3),
-            per_var: 3e-6,
-            wrap_up: ms(0),
-        };
+        let old = solves(8, 2e-6, 2);
+        let seen = solves(3, 3e-6, 0);
         let next = old.after(seen);
         assert_eq!(next.setup, ms(4));
         assert_eq!(next.per_var, 3e-6);
@@ -179,12 +250,53 @@ mod tests {
     }
 
     #[test]
-    fn a_solve_fits_only_past_its_set_up_and_wrap_up() {
-        let t = SolveTiming {
-            setup: ms(5),
-            per_var: 1e-6,
-            wrap_up: ms(2),
+    fn the_stage_fits_only_past_the_ranking_and_a_solve() {
+        let t = solves(5, 1e-6, 2);
+        let stage = StageTiming {
+            ranking: ms(30),
+            fallback: ms(1),
+            floor: ms(10),
         };
+        assert!(!stage.fits_the_stage(&t, ms(37)));
+        assert!(stage.fits_the_stage(&t, ms(37) + Duration::from_nanos(1)));
+        // The priors: a 5 ms budget holds no stage, a second does.
+        for three_d in [false, true] {
+            let p = StageTiming::prior(three_d);
+            let s = SolveTiming::prior(three_d);
+            assert!(!p.fits_the_stage(&s, ms(5)) && p.fits_the_stage(&s, ms(1000)));
+        }
+    }
+
+    #[test]
+    fn the_ranking_estimate_follows_done_backs_off_when_cut_and_decays_to_its_floor() {
+        let stage = StageTiming::prior(false);
+        assert_eq!(stage.floor, stage.ranking / 2);
+        // Done: what it took, either way.
+        let done = stage.after(Ranking::Done(ms(42)), ms(1));
+        assert_eq!(done.ranking, ms(42));
+        assert_eq!(stage.after(Ranking::Done(ms(3)), ms(1)).ranking, ms(3));
+        // Cut after 15 ms: at least 30.
+        assert_eq!(stage.after(Ranking::Cut(ms(15)), ms(1)).ranking, ms(30));
+        assert_eq!(done.after(Ranking::Cut(ms(15)), ms(1)).ranking, ms(42));
+        // Skipped: a tenth lower each time, never under the floor.
+        let once = done.after(Ranking::Skipped, ms(1));
+        assert_eq!(once.ranking, ms(42).mul_f64(0.9));
+        let mut s = done;
+        for _ in 0..100 {
+            s = s.after(Ranking::Skipped, ms(1));
+        }
+        assert_eq!(s.ranking, stage.floor);
+        // The fallback: this one's, or half the estimate if that is longer.
+        assert_eq!(stage.after(Ranking::Skipped, ms(2)).fallback, ms(2));
+        assert_eq!(
+            stage.after(Ranking::Skipped, Duration::ZERO).fallback,
+            stage.fallback / 2
+        );
+    }
+
+    #[test]
+    fn a_solve_fits_only_past_its_set_up_and_wrap_up() {
+        let t = solves(5, 1e-6, 2);
         assert!(
             !t.fits_a_solve(Duration::ZERO),
             "an expired deadline fits none"
