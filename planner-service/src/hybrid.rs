@@ -617,9 +617,10 @@ impl Planner {
         let (timing, stage_timing) = (self.timing[model], self.stage[model]);
         // The NLP stage only when the budget left after the swarm's share (and the
         // fallback's reserve) can hold it, as recent plans took it: it yields nothing before
-        // its ranking is done. Otherwise the swarm has all of the budget but the reserve.
+        // its ranking is done. Otherwise the swarm has all of the budget but the reserve
+        // (twice the fallback's cost, at most half the budget).
         let share = settings.swarm_share.clamp(0.0, 1.0);
-        let reserve = stage_timing.fallback * 2;
+        let reserve = (stage_timing.fallback * 2).min(deadline.remaining() / 2);
         let after_swarm = deadline.remaining().mul_f64(1.0 - share);
         let nlp_possible =
             stage_timing.fits_the_stage(&timing, after_swarm.saturating_sub(reserve));
@@ -660,8 +661,9 @@ impl Planner {
         };
         // No time left for the ranking and one solve's set-up and wrap-up after it (as
         // recent plans measured them): no NLP stage at all, not even its starts (2-3 ms of
-        // dense costs). (An expired deadline is one of these.)
-        let no_time = !nlp_possible || !stage_timing.fits_the_stage(&timing, deadline.remaining());
+        // dense costs). (An expired deadline is one of these.) Asked again now: a swarm
+        // that converged early may have left the time for it.
+        let no_time = !stage_timing.fits_the_stage(&timing, deadline.remaining());
         // Starts from distinct basins, solved side by side on the first mesh.
         // The swarm's workspace holds this problem's seeds: no need to build them again.
         let starts = if no_time {
@@ -775,10 +777,14 @@ impl Planner {
         }
         times.nlp = clock.now().saturating_sub(nlp_started);
         self.timing[model] = self.timing[model].after(stage.seen.get());
-        let ranking = match (no_time, cut) {
-            (true, _) => Ranking::Skipped,
-            (false, true) => Ranking::Cut(times.ranking),
-            (false, false) => Ranking::Done(times.ranking),
+        // The stage ran out of time before it had a plan (a rank or every final stopped by
+        // the deadline): it needs more than it had. Else its ranking took what it took.
+        let ranking = if no_time {
+            Ranking::Skipped
+        } else if accepted.is_none() && (cut || deadline.expired()) {
+            Ranking::Cut(times.nlp)
+        } else {
+            Ranking::Done(times.ranking)
         };
         self.stage[model] = stage_timing.after(ranking, fallback_cost);
 

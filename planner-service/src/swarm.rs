@@ -107,10 +107,11 @@
 //! The deadline is checked before every round of the particles: one starts only while it
 //! still fits (as long as the longest round so far; the first as long as scoring as many
 //! seeds), else the best so far is returned with [`SwarmStatus::MaxTime`] (with a deadline
-//! already passed: the best seed). Every
-//! buffer is allocated in [`SwarmWorkspace::new`]; a run allocates only to build the
-//! seeds, to start its worker threads and for the returned trajectories, never in the
-//! iteration loop (`tests/swarm_no_alloc.rs`).
+//! already passed: the best seed). So only a run that ends within a round of its deadline
+//! depends on the clock; any other gives the same bits for the same seed. Every buffer is
+//! allocated in [`SwarmWorkspace::new`]; a run allocates only to build the seeds, to start
+//! its worker threads and for the returned trajectories, never in the iteration loop
+//! (`tests/swarm_no_alloc.rs`).
 //!
 //! # Defaults
 //!
@@ -1000,8 +1001,8 @@ pub fn run(
                 seed_scores[i] = s;
             }
         }
-        // A round of the particles takes about as long as scoring as many seeds: the
-        // estimate of the first round (tracking the seeds onto the particles included),
+        // A round of the particles takes about as long as scoring as many seeds (tracking
+        // the seeds onto the particles first takes less): the estimate of the first round,
         // until one is measured.
         let mut round = clock
             .now()
@@ -1115,7 +1116,6 @@ pub fn run(
             group_score[k] = group_score[0];
         }
         // Particles.
-        let first_round = clock.now();
         let mut rng = ChaCha8Rng::seed_from_u64(settings.seed);
         let mut j = 0;
         for m in shards {
@@ -1145,6 +1145,7 @@ pub fn run(
                 j += 1;
             }
         }
+        let first_round = clock.now();
         let mut alive = run_job(JOB_PARTICLES);
         round = clock.now().saturating_sub(first_round);
         // Local bests are the particles themselves; group bests (from their leaders)

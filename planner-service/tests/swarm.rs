@@ -4,11 +4,10 @@
 //! small settings (8–16 particles, 10–40 iterations) to stay fast in debug builds; the
 //! default settings' speed and quality are in the bench (`benches/swarm.rs`).
 
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 
 use wingman_interfaces::{Model, Objective};
-use wingman_planner::clock::{Clock, Deadline, ManualClock};
+use wingman_planner::clock::{Deadline, ManualClock};
 use wingman_planner::dynamics::wrap_angle;
 use wingman_planner::problem::Problem;
 use wingman_planner::scenario::{self, BUNDLED};
@@ -16,6 +15,10 @@ use wingman_planner::seeding::SeedSettings;
 use wingman_planner::swarm::{
     self, Parameterisation, SwarmError, SwarmOutcome, SwarmSettings, SwarmStatus, SwarmWorkspace,
 };
+
+#[path = "support/ticking_clock.rs"]
+mod ticking_clock;
+use ticking_clock::TickingClock;
 
 fn problem(name: &str) -> Problem {
     let sc = scenario::bundled(name)
@@ -221,19 +224,9 @@ fn an_expired_deadline_returns_the_best_seed() {
     assert!(o.best.is_valid());
 }
 
-/// A clock that moves 1 ms every time it is read.
-#[derive(Default)]
-struct TickingClock(AtomicU64);
-
-impl Clock for TickingClock {
-    fn now(&self) -> Duration {
-        Duration::from_millis(self.0.fetch_add(1, Ordering::SeqCst))
-    }
-}
-
 /// The number of seeds of `p` under `s`, and a run on a [`TickingClock`] whose budget
-/// covers the seeds (each built and each scored reads the clock once) and `extra` more
-/// readings.
+/// covers the seeds (each built and each scored but the first reads the clock once) and
+/// about `extra` more readings.
 fn ticking_run(p: &Problem, s: &SwarmSettings, extra: u64) -> (u64, SwarmOutcome) {
     let mut ws = SwarmWorkspace::new(s);
     let seeds = run(p, s, &mut ws).seeds as u64;
@@ -283,6 +276,7 @@ fn no_round_starts_that_would_end_past_the_deadline() {
     assert_eq!(o.status, SwarmStatus::MaxTime);
     assert_eq!(o.seeds as u64, seeds, "every seed scored");
     assert_eq!(o.iterations, 0, "no round started");
+    assert_eq!(o.evaluations, o.seeds, "not even the particles' first");
     assert!(o.best.is_valid());
     assert_eq!(o.cost, o.seeds_best_cost);
 }

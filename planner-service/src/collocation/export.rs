@@ -25,7 +25,9 @@ use crate::trajectory::Trajectory;
 pub struct ExportSettings {
     /// Largest step between samples.
     pub max_step_s: f64,
-    /// Largest integration step of the closed-loop replay. 0.25 s (two RK4 steps per
+    /// Largest integration step of the closed-loop replay's flight (its prediction of the
+    /// next sample, which only picks the next control, is one RK4 step over the sample
+    /// spacing, whatever this is). 0.25 s (two RK4 steps per
     /// 0.5 s sample): the exported states stay within 7 cm of the judge's open-loop replay
     /// (DOP853, rtol 1e-11) on the 3-D canonical plans, against 0.3 mm at 0.1 s, for half
     /// the replay's cost (docs/BENCHMARKS.md).

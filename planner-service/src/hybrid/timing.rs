@@ -105,7 +105,7 @@ pub(super) enum Ranking {
     Skipped,
     /// Every start ranked, in this long.
     Done(Duration),
-    /// Stopped by the deadline after this long.
+    /// The stage ran out of time before it had a plan, after this long.
     Cut(Duration),
 }
 
@@ -114,10 +114,10 @@ impl StageTiming {
     /// below the shortest rankings of the canonical scenarios (2-D 25-50 ms on a 2.6 GHz
     /// EPYC, 40-110 ms on a 2.3 GHz Xeon VM; 3-D 55-220 ms and 90-300 ms), so that a
     /// budget that might hold the stage tries it; the fallback about the longest seen
-    /// (2-D 0.1-0.3 ms, 3-D 1-3 ms).
+    /// on the Xeon (2-D 0.1-0.3 ms, 3-D 0.5-2 ms).
     pub fn prior(three_d: bool) -> StageTiming {
         let (ranking, fallback) = if three_d {
-            (Duration::from_millis(50), Duration::from_millis(3))
+            (Duration::from_millis(50), Duration::from_millis(2))
         } else {
             (Duration::from_millis(20), Duration::from_micros(500))
         };
@@ -135,16 +135,17 @@ impl StageTiming {
     }
 
     /// The estimate after a plan whose ranking ended as `ranking` and whose fallback took
-    /// `fallback`. A ranking done: its time. One cut by the deadline: at least twice what it
-    /// had (the next tries wait until the estimate has come down again). None: a tenth
-    /// lower, down to the floor, so that a later plan tries again (a host that was slow
-    /// for a while is tried again). The fallback: the longer of this one and half the
+    /// `fallback`. A ranking done: its time (not under the floor: a ranking whose solves
+    /// failed fast says little). A stage that ran out of time: at least twice what it had
+    /// (the next tries wait until the estimate has come down again). None: a tenth lower,
+    /// down to the floor, so that a later plan tries again (a host that was slow for a
+    /// while is tried again). The fallback: the longer of this one and half the
     /// estimate.
     pub fn after(self, ranking: Ranking, fallback: Duration) -> StageTiming {
         StageTiming {
             ranking: match ranking {
                 Ranking::Skipped => self.ranking.mul_f64(0.9).max(self.floor),
-                Ranking::Done(d) => d,
+                Ranking::Done(d) => d.max(self.floor),
                 Ranking::Cut(d) => self.ranking.max(d * 2),
             },
             fallback: fallback.max(self.fallback / 2),
@@ -271,10 +272,13 @@ mod tests {
     fn the_ranking_estimate_follows_done_backs_off_when_cut_and_decays_to_its_floor() {
         let stage = StageTiming::prior(false);
         assert_eq!(stage.floor, stage.ranking / 2);
-        // Done: what it took, either way.
+        // Done: what it took, but not under the floor.
         let done = stage.after(Ranking::Done(ms(42)), ms(1));
         assert_eq!(done.ranking, ms(42));
-        assert_eq!(stage.after(Ranking::Done(ms(3)), ms(1)).ranking, ms(3));
+        assert_eq!(
+            stage.after(Ranking::Done(ms(3)), ms(1)).ranking,
+            stage.floor
+        );
         // Cut after 15 ms: at least 30.
         assert_eq!(stage.after(Ranking::Cut(ms(15)), ms(1)).ranking, ms(30));
         assert_eq!(done.after(Ranking::Cut(ms(15)), ms(1)).ranking, ms(42));
