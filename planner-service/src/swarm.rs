@@ -1182,17 +1182,23 @@ pub fn run(
         group_reference[..groups].copy_from_slice(group_score);
         let group_reference = &mut group_reference[..groups];
         let mut last_gain = 0;
+        let mut last_left: Option<Duration> = None;
         while alive {
             if iterations >= settings.max_iterations {
                 status = SwarmStatus::MaxIterations;
                 break;
             }
-            // Stop while the next iteration still fits (as long as the longest so far).
-            if deadline.remaining() <= round {
+            // Stop while the next iteration still fits: as long as the longest so far, each
+            // measured from one of these checks to the next.
+            let left = deadline.remaining();
+            if let Some(before) = last_left {
+                round = round.max(before.saturating_sub(left));
+            }
+            if left <= round {
                 status = SwarmStatus::MaxTime;
                 break;
             }
-            let iteration_started = clock.now();
+            last_left = Some(left);
             iterations += 1;
             // Update (eq. 4.1), random numbers in particle order; the attractor `G` is the
             // particle's group best until the merge, then the global best.
@@ -1276,7 +1282,6 @@ pub fn run(
             }
             evaluations += settings.particles;
             history.push(gscore.cost);
-            round = round.max(clock.now().saturating_sub(iteration_started));
             // A gain: the global best improved, or (before the merge) any group's best.
             let tol = settings.stall_tolerance;
             let better = |now: &Score, was: &Score| {

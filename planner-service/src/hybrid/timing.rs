@@ -131,7 +131,7 @@ impl StageTiming {
     /// Whether `remaining` (after the swarm) leaves time for the stage to yield a plan:
     /// the ranking, then one solve's set-up and wrap-up (`solves`).
     pub fn fits_the_stage(&self, solves: &SolveTiming, remaining: Duration) -> bool {
-        remaining > self.ranking + solves.setup + solves.wrap_up
+        remaining > self.ranking && solves.fits_a_solve(remaining - self.ranking)
     }
 
     /// The estimate after a plan whose ranking ended as `ranking` and whose fallback took
