@@ -55,6 +55,10 @@ fn peak_of(run: impl FnOnce()) -> isize {
     PEAK.load(Ordering::Relaxed)
 }
 
+#[path = "support/kkt_block.rs"]
+mod kkt_block;
+use kkt_block::kkt_block;
+
 #[global_allocator]
 static GLOBAL: Peak = Peak;
 
@@ -72,38 +76,12 @@ fn host_reference_ms() -> f64 {
     })
 }
 
-/// One thread's part of [`host_reference_ms`].
+/// One thread's part of [`host_reference_ms`]: the block of the kkt bench's `n = 72`
+/// case (42 primal and 30 dual rows).
 fn reference_workload_ms() -> f64 {
     use wingman_planner::collocation::bunch_kaufman as bk;
     const N: usize = 72;
-    const PRIMAL: usize = 42;
-    // Primal rows: a positive diagonal with 6 × 6 node blocks; dual rows: coupled to
-    // every third primal column, a tiny negative diagonal (an indefinite saddle point).
-    let mut k = vec![0.0; N * N];
-    for i in 0..N {
-        for j in 0..=i {
-            let v = if i < PRIMAL {
-                if i == j {
-                    1.5 + 0.5 * (i as f64).sin()
-                } else if i / 6 == j / 6 {
-                    0.2 * ((i * 7 + j * 3) as f64).sin()
-                } else {
-                    0.0
-                }
-            } else if j < PRIMAL {
-                if (i + j) % 3 == 0 {
-                    ((i * 5 + j) as f64).cos()
-                } else {
-                    0.0
-                }
-            } else if i == j {
-                -1e-8
-            } else {
-                0.0
-            };
-            k[i + j * N] = v;
-        }
-    }
+    let k = kkt_block(42, 30, N as u64);
     let mut a = k.clone();
     let mut piv = vec![0i32; N];
     let mut work = vec![0.0; bk::work_len(N)];
