@@ -701,7 +701,13 @@ impl Workspace {
         let nb = self.border.len();
         match self.blocks.get(owner) {
             Some(b) => {
-                self.dense[b.a_off..b.a_off + b.n * b.n].fill(0.0);
+                // Only the lower triangle: nothing writes above the diagonal (the entries
+                // are placed below it, the factorisation works below it), so the upper
+                // triangle keeps the zeros it was allocated with.
+                let a = &mut self.dense[b.a_off..b.a_off + b.n * b.n];
+                for (j, col) in a.chunks_exact_mut(b.n).enumerate() {
+                    col[j..].fill(0.0);
+                }
                 let c = self.c_base + b.c_off;
                 self.dense[c..c + b.n * b.l].fill(0.0);
                 let w = self.w_base + b.w_off;
@@ -1596,6 +1602,52 @@ mod tests {
                 assert!(
                     err < 1e-9,
                     "unrefined: differs from LU by {err:e} (relative)"
+                );
+            }
+        }
+    }
+
+    /// A workspace that factored one matrix factors the next exactly as a fresh one does
+    /// (the same solution, bit for bit, and the same inertia): the assembly restores every
+    /// entry the elimination reads, and nothing above a block's diagonal is ever written
+    /// (it stays at its allocated zeros, so the assembly clears only the lower triangle).
+    #[test]
+    fn a_reused_workspace_factors_as_a_fresh_one() {
+        let mut rng = ChaCha8Rng::seed_from_u64(17);
+        let mut a = arrowhead(&[10, 12, 9, 11], 3, true, &mut rng);
+        let groups = add_groups(&mut a, 2, 1e-2, &mut rng);
+        let dim = a.k.nrows();
+        let labels = KktLabels {
+            blocks: a.labels.clone(),
+            groups,
+        };
+        // Same pattern, new values: indefinite diagonals (2x2 pivots), new couplings.
+        let second: Vec<f64> =
+            a.va.iter()
+                .map(|v| v * rng.random_range(-1.5..1.5))
+                .collect();
+        let b: Vec<f64> = (0..dim).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let mut used = StructuredKkt::new(Some(labels.clone()), feral_cfg());
+        let mut x_used = b.clone();
+        let _ = solve_with(&mut used, &a.ia, &a.ja, &a.va, &mut x_used, 1, None);
+        let mut x_used = b.clone();
+        used.values_array_mut().copy_from_slice(&second);
+        let status = used.multi_solve(true, &a.ia, &a.ja, 1, &mut x_used, false, 0);
+        let mut fresh = StructuredKkt::new(Some(labels), feral_cfg());
+        let mut x_fresh = b.clone();
+        let status_fresh = solve_with(&mut fresh, &a.ia, &a.ja, &second, &mut x_fresh, 1, None);
+        assert_eq!(status, status_fresh);
+        assert_eq!(used.block_factorizations, 2, "both by block elimination");
+        assert_eq!(used.number_of_neg_evals(), fresh.number_of_neg_evals());
+        let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&x_used), bits(&x_fresh), "reused and fresh differ");
+        let ws = used.ws.as_ref().expect("the labels fit");
+        for blk in &ws.blocks {
+            let a = &ws.dense[blk.a_off..blk.a_off + blk.n * blk.n];
+            for j in 0..blk.n {
+                assert!(
+                    a[j * blk.n..j * blk.n + j].iter().all(|&v| v == 0.0),
+                    "written above the diagonal"
                 );
             }
         }
