@@ -341,6 +341,19 @@ struct Workspace {
     g_nz_len: Vec<usize>,
 }
 
+/// Zeroes the lower triangle (with the diagonal) of the column-major `n × n` matrix `a`.
+/// The symmetric matrices the blocked elimination factors (each block's `A`, the border's
+/// `S`) are assembled, updated and factorised below their diagonal only, so what lies above
+/// it keeps the zeros it was allocated with and needs no clearing.
+fn clear_lower(a: &mut [f64], n: usize) {
+    if n == 0 {
+        return;
+    }
+    for (j, col) in a.chunks_exact_mut(n).enumerate() {
+        col[j..].fill(0.0);
+    }
+}
+
 /// Largest multiplier `|G⁻¹ B|` a pivot group may have: a larger one would amplify
 /// rounding beyond what the refinement recovers, so FERAL factors that matrix instead.
 const GROUP_GROWTH_MAX: f64 = 1e6;
@@ -701,20 +714,14 @@ impl Workspace {
         let nb = self.border.len();
         match self.blocks.get(owner) {
             Some(b) => {
-                // Only the lower triangle: nothing writes above the diagonal (the entries
-                // are placed below it, the factorisation works below it), so the upper
-                // triangle keeps the zeros it was allocated with.
-                let a = &mut self.dense[b.a_off..b.a_off + b.n * b.n];
-                for (j, col) in a.chunks_exact_mut(b.n).enumerate() {
-                    col[j..].fill(0.0);
-                }
+                clear_lower(&mut self.dense[b.a_off..b.a_off + b.n * b.n], b.n);
                 let c = self.c_base + b.c_off;
                 self.dense[c..c + b.n * b.l].fill(0.0);
                 let w = self.w_base + b.w_off;
                 self.dense[w..w + b.n * b.m].fill(0.0);
                 self.dense[b.gs_off..b.gs_off + b.gs_len].fill(0.0);
             }
-            None => self.dense[self.s_off..self.s_off + nb * nb].fill(0.0),
+            None => clear_lower(&mut self.dense[self.s_off..self.s_off + nb * nb], nb),
         }
         let mut finite = true;
         let group = &self.by_owner[self.owner_start[owner]..self.owner_start[owner + 1]];
@@ -1610,7 +1617,8 @@ mod tests {
     /// A workspace that factored one matrix factors the next exactly as a fresh one does
     /// (the same solution, bit for bit, and the same inertia): the assembly restores every
     /// entry the elimination reads, and nothing above a block's diagonal is ever written
-    /// (it stays at its allocated zeros, so the assembly clears only the lower triangle).
+    /// nor above the border's (they stay at their allocated zeros, so the assembly clears
+    /// only the lower triangles).
     #[test]
     fn a_reused_workspace_factors_as_a_fresh_one() {
         let mut rng = ChaCha8Rng::seed_from_u64(17);
@@ -1642,11 +1650,18 @@ mod tests {
         let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&x_used), bits(&x_fresh), "reused and fresh differ");
         let ws = used.ws.as_ref().expect("the labels fit");
-        for blk in &ws.blocks {
-            let a = &ws.dense[blk.a_off..blk.a_off + blk.n * blk.n];
-            for j in 0..blk.n {
+        let nb = ws.border.len();
+        assert!(nb > 0, "the draw has a border");
+        let squares = ws
+            .blocks
+            .iter()
+            .map(|blk| (blk.a_off, blk.n))
+            .chain([(ws.s_off, nb)]);
+        for (off, n) in squares {
+            let a = &ws.dense[off..off + n * n];
+            for j in 0..n {
                 assert!(
-                    a[j * blk.n..j * blk.n + j].iter().all(|&v| v == 0.0),
+                    a[j * n..j * n + j].iter().all(|&v| v == 0.0),
                     "written above the diagonal"
                 );
             }
