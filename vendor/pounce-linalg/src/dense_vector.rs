@@ -92,15 +92,15 @@ mod storage_pool {
         static POOL: RefCell<Vec<Vec<Number>>> = const { RefCell::new(Vec::new()) };
     }
 
-    /// A buffer of `len` copies of `fill`: a kept one of exactly that capacity if any,
-    /// else a new one.
+    /// A buffer of `len` copies of `fill`: the newest kept one of exactly that capacity
+    /// if any, else a new one.
     pub(super) fn take(len: usize, fill: Number) -> Vec<Number> {
         if len >= MIN_LEN
             && let Ok(Some(mut v)) = POOL.try_with(|p| {
                 let mut p = p.borrow_mut();
                 p.iter()
                     .rposition(|v| v.capacity() == len)
-                    .map(|i| p.swap_remove(i))
+                    .map(|i| p.remove(i))
             })
         {
             v.clear();
@@ -110,15 +110,24 @@ mod storage_pool {
         vec![fill; len]
     }
 
-    /// Keeps `v`'s buffer for a later [`take`] (or frees it).
+    /// The capacities of the kept buffers, oldest first (tests).
+    #[cfg(test)]
+    pub(super) fn sizes() -> Vec<usize> {
+        POOL.with(|p| p.borrow().iter().map(Vec::capacity).collect())
+    }
+
+    /// Keeps `v`'s buffer for a later [`take`], in place of the one kept longest when
+    /// the pool is full (so that buffers of a finished solve's sizes give way to the
+    /// next solve's).
     pub(super) fn give(v: Vec<Number>) {
         if v.capacity() < MIN_LEN {
             return;
         }
         let _ = POOL.try_with(|p| {
-            if let Ok(mut p) = p.try_borrow_mut()
-                && p.len() < KEPT
-            {
+            if let Ok(mut p) = p.try_borrow_mut() {
+                if p.len() >= KEPT {
+                    p.remove(0);
+                }
                 p.push(v);
             }
         });
@@ -993,6 +1002,12 @@ mod tests {
         other.ensure_storage();
         assert_eq!(other.values.len(), n + 1);
         assert!(other.values.iter().all(|&v| v == 0.0));
+        // A full pool makes room for new sizes: the oldest buffers go first.
+        let u = DenseVectorSpace::new(n as Index + 2);
+        let many: Vec<DenseVector> = (0..200).map(|_| vec_of(&u, &vec![1.0; n + 2])).collect();
+        drop(many);
+        let kept = storage_pool::sizes();
+        assert!(kept.len() <= 64 && kept.iter().all(|&c| c == n + 2), "{kept:?}");
     }
 
     #[test]
