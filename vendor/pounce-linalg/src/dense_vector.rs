@@ -82,6 +82,7 @@ impl DenseVectorSpace {
 mod storage_pool {
     use super::Number;
     use std::cell::RefCell;
+    use std::collections::VecDeque;
 
     /// Most buffers kept per thread.
     const KEPT: usize = 64;
@@ -89,7 +90,9 @@ mod storage_pool {
     const MIN_LEN: usize = 32;
 
     thread_local! {
-        static POOL: RefCell<Vec<Vec<Number>>> = const { RefCell::new(Vec::new()) };
+        // Oldest first; a deque, so that the oldest gives way without shifting the rest
+        // (every drop of a vector gives, on the solver's hot path).
+        static POOL: RefCell<VecDeque<Vec<Number>>> = const { RefCell::new(VecDeque::new()) };
     }
 
     /// A buffer of `len` copies of `fill`: the newest kept one of exactly that capacity
@@ -100,7 +103,7 @@ mod storage_pool {
                 let mut p = p.borrow_mut();
                 p.iter()
                     .rposition(|v| v.capacity() == len)
-                    .map(|i| p.remove(i))
+                    .and_then(|i| p.remove(i))
             })
         {
             v.clear();
@@ -126,9 +129,9 @@ mod storage_pool {
         let _ = POOL.try_with(|p| {
             if let Ok(mut p) = p.try_borrow_mut() {
                 if p.len() >= KEPT {
-                    p.remove(0);
+                    p.pop_front();
                 }
-                p.push(v);
+                p.push_back(v);
             }
         });
     }
