@@ -268,9 +268,11 @@ fn main() {
     }
     println!("worst cost/ref {worst:.5}");
     println!(
-        "KKT factorisations: {} by block elimination ({} without pivot groups), {} handed to FERAL",
+        "KKT factorisations: {} by block elimination ({} without pivot groups, {} stopped on a \
+         surplus of negative eigenvalues), {} handed to FERAL",
         wingman_planner::collocation::kkt::block_factorizations_total(),
         wingman_planner::collocation::kkt::plain_factorizations_total(),
+        wingman_planner::collocation::kkt::surplus_stops_total(),
         wingman_planner::collocation::kkt::feral_fallbacks_total()
     );
 }

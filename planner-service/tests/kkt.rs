@@ -95,17 +95,25 @@ fn structured_solve_reaches_ferals_objective_3d_rendezvous() {
 /// `3 · phases + 3` indices (the phase times, the phase-order rows' slacks and duals, the
 /// rendezvous rows); then factorising and solving again and again (two right-hand sides)
 /// allocates nothing.
-fn labels_fit_and_do_not_allocate(name: &str) {
-    let (p, guess) = planned(name);
-    let mesh = Mesh::uniform(5, &phase_durations(p.t0, &guess), 35.0, 2);
-    let tr = Transcription::new(&p, &mesh, &guess, &TranscriptionSettings::default());
-    let labels = KktLabels::of(&tr);
-    let border = labels.blocks.iter().filter(|&&l| l < 0).count();
-    let phases = mesh.phases.len();
-    assert!(
-        border <= 3 * phases + 3,
-        "{name}: border of {border} with {phases} phases"
-    );
+/// What an entry of a transcription's KKT is, as pounce assembles it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Entry {
+    /// The diagonal of a primal variable or slack.
+    PrimalDiagonal,
+    /// The diagonal of a multiplier.
+    DualDiagonal,
+    /// An off-diagonal Hessian entry.
+    Hessian,
+    /// A Jacobian entry.
+    Jacobian,
+    /// An inequality row's slack.
+    Slack,
+}
+
+/// The KKT pattern pounce assembles for `tr` (`[x not fixed | slacks | equality duals |
+/// inequality duals]`, Hessian and Jacobian entries, every diagonal): its order, number
+/// of multipliers, and entries (0-based, lower triangle).
+fn kkt_pattern(tr: &Transcription) -> (usize, usize, Vec<(usize, usize, Entry)>) {
     // KKT positions, as pounce numbers them.
     let fixed = |i: usize| tr.x_lo[i] == tr.x_hi[i];
     let mut xpos = vec![usize::MAX; tr.n_vars()];
@@ -131,38 +139,70 @@ fn labels_fit_and_do_not_allocate(name: &str) {
         }
     }
     let dim = n + 2 * n_d + n_c;
-    let (mut ia, mut ja, mut va) = (Vec::new(), Vec::new(), Vec::new());
-    let mut push = |i: usize, j: usize, v: f64| {
-        ia.push(i.max(j) as i32 + 1);
-        ja.push(i.min(j) as i32 + 1);
-        va.push(v);
-    };
+    let mut entries = Vec::new();
+    let mut push = |i: usize, j: usize, e: Entry| entries.push((i.max(j), i.min(j), e));
     for i in 0..dim {
-        // Primal diagonal positive, dual diagonal negative: a quasi-definite KKT.
-        push(
-            i,
-            i,
-            if i < n + n_d {
-                4.0 + (i % 5) as f64
-            } else {
-                -1e-2
-            },
-        );
+        let e = if i < n + n_d {
+            Entry::PrimalDiagonal
+        } else {
+            Entry::DualDiagonal
+        };
+        push(i, i, e);
     }
     for &(r, c) in &tr.hess {
         if xpos[r] != usize::MAX && xpos[c] != usize::MAX && r != c {
-            push(xpos[r], xpos[c], 0.1);
+            push(xpos[r], xpos[c], Entry::Hessian);
         }
     }
     for &(r, c) in &tr.jac {
         if xpos[c] != usize::MAX {
             let row = if eq(r) { cpos[r] } else { dpos[r] };
-            push(row, xpos[c], 0.3);
+            push(row, xpos[c], Entry::Jacobian);
         }
     }
     for (k, r) in (0..tr.n_cons()).filter(|&r| !eq(r)).enumerate() {
-        push(dpos[r], n + k, -1.0);
+        push(dpos[r], n + k, Entry::Slack);
     }
+    (dim, n_c + n_d, entries)
+}
+
+/// 1-based triplets of `entries`.
+fn triplets(entries: &[(usize, usize, Entry)]) -> (Vec<i32>, Vec<i32>) {
+    entries
+        .iter()
+        .map(|&(i, j, _)| (i as i32 + 1, j as i32 + 1))
+        .unzip()
+}
+
+/// The labels of a real transcription of `name`, on a KKT pattern assembled as pounce
+/// assembles it ([`kkt_pattern`]), are accepted, with a border of at most
+/// `3 · phases + 3` indices (the phase times, the phase-order rows' slacks and duals, the
+/// rendezvous rows); then factorising and solving again and again (two right-hand sides)
+/// allocates nothing.
+fn labels_fit_and_do_not_allocate(name: &str) {
+    let (p, guess) = planned(name);
+    let mesh = Mesh::uniform(5, &phase_durations(p.t0, &guess), 35.0, 2);
+    let tr = Transcription::new(&p, &mesh, &guess, &TranscriptionSettings::default());
+    let labels = KktLabels::of(&tr);
+    let border = labels.blocks.iter().filter(|&&l| l < 0).count();
+    let phases = mesh.phases.len();
+    assert!(
+        border <= 3 * phases + 3,
+        "{name}: border of {border} with {phases} phases"
+    );
+    let (dim, m, entries) = kkt_pattern(&tr);
+    let (ia, ja) = triplets(&entries);
+    // Primal diagonal positive, dual diagonal negative: a quasi-definite KKT.
+    let va: Vec<f64> = entries
+        .iter()
+        .map(|&(i, _, e)| match e {
+            Entry::PrimalDiagonal => 4.0 + (i % 5) as f64,
+            Entry::DualDiagonal => -1e-2,
+            Entry::Hessian => 0.1,
+            Entry::Jacobian => 0.3,
+            Entry::Slack => -1.0,
+        })
+        .collect();
     let mut solver = StructuredKkt::new(Some(labels), Default::default());
     let nnz = ia.len() as i32;
     assert_eq!(
@@ -176,7 +216,7 @@ fn labels_fit_and_do_not_allocate(name: &str) {
     let mut rhs = vec![1.0; 2 * dim];
     let round = |solver: &mut StructuredKkt, rhs: &mut [f64]| {
         solver.values_array_mut().copy_from_slice(&va);
-        let status = solver.multi_solve(true, &ia, &ja, 2, rhs, true, (n_c + n_d) as i32);
+        let status = solver.multi_solve(true, &ia, &ja, 2, rhs, true, m as i32);
         assert_eq!(status, ESymSolverStatus::Success);
         let status = solver.multi_solve(false, &ia, &ja, 2, rhs, false, 0);
         assert_eq!(status, ESymSolverStatus::Success);
@@ -254,4 +294,99 @@ fn pivot_groups_2d() {
 #[test]
 fn pivot_groups_3d() {
     groups_are_the_nodes_controls_and_driven_rows("3d-min-time-rendezvous-unavoidable");
+}
+
+/// The early stop on a surplus of negative eigenvalues, on KKTs of a real transcription of
+/// `name` with random values: Hessian diagonals drawn below zero with probability `p`
+/// (so that many draws have the wrong inertia), the multipliers' diagonal 0 or −1e-8
+/// (pounce's `δ_c`). Checked against nalgebra's dense `SymmetricEigen`: the status is
+/// `Success` exactly when the matrix has as many negative eigenvalues as multipliers, a
+/// wrong inertia is always reported as one, with a count on the right side of the
+/// expected one, and some draws stop early.
+fn surplus_stops_agree_with_the_eigenvalues(name: &str) {
+    use nalgebra::{DMatrix, SymmetricEigen};
+    use rand::{RngExt, SeedableRng};
+    let (p, guess) = planned(name);
+    let mesh = Mesh::uniform(4, &phase_durations(p.t0, &guess), 120.0, 3);
+    let tr = Transcription::new(&p, &mesh, &guess, &TranscriptionSettings::default());
+    let (dim, m, entries) = kkt_pattern(&tr);
+    let (ia, ja) = triplets(&entries);
+    let mut solver = StructuredKkt::new(Some(KktLabels::of(&tr)), Default::default());
+    assert_eq!(
+        solver.initialize_structure(dim as i32, ia.len() as i32, &ia, &ja),
+        ESymSolverStatus::Success
+    );
+    assert!(solver.is_structured());
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+    let (mut right, mut wrong, mut judged) = (0, 0, 0);
+    for draw in 0..24 {
+        let p_negative = [0.0, 0.05, 0.2, 0.5][draw % 4];
+        let delta_c = if draw % 8 < 4 { 0.0 } else { 1e-8 };
+        let va: Vec<f64> = entries
+            .iter()
+            .map(|&(_, _, e)| match e {
+                Entry::PrimalDiagonal if rng.random_range(0.0..1.0) < p_negative => {
+                    rng.random_range(-10.0..-2.0)
+                }
+                Entry::PrimalDiagonal => rng.random_range(1.0..4.0),
+                Entry::DualDiagonal => -delta_c,
+                Entry::Hessian => rng.random_range(-0.2..0.2),
+                Entry::Jacobian => rng.random_range(-1.0..1.0),
+                Entry::Slack => -1.0,
+            })
+            .collect();
+        let mut k = DMatrix::<f64>::zeros(dim, dim);
+        for (&(i, j, _), &v) in entries.iter().zip(&va) {
+            k[(i, j)] += v;
+            if i != j {
+                k[(j, i)] += v;
+            }
+        }
+        let eig = SymmetricEigen::new(k).eigenvalues;
+        if eig.iter().any(|l| l.abs() < 1e-9) {
+            continue;
+        }
+        let negative = eig.iter().filter(|&&l| l < 0.0).count();
+        let feral_before = solver.feral_factorizations;
+        solver.values_array_mut().copy_from_slice(&va);
+        let mut rhs = vec![1.0; dim];
+        let status = solver.multi_solve(true, &ia, &ja, 1, &mut rhs, true, m as i32);
+        if solver.feral_factorizations != feral_before {
+            continue;
+        }
+        judged += 1;
+        if negative == m {
+            right += 1;
+            assert_eq!(status, ESymSolverStatus::Success, "{name}, draw {draw}");
+        } else {
+            wrong += 1;
+            assert_eq!(
+                status,
+                ESymSolverStatus::WrongInertia,
+                "{name}, draw {draw}"
+            );
+            let reported = solver.number_of_neg_evals() as usize;
+            assert_eq!(reported < m, negative < m, "{name}, draw {draw}: side");
+        }
+    }
+    assert!(judged >= 16, "{name}: only {judged} draws judged");
+    assert!(
+        right >= 4 && wrong >= 4,
+        "{name}: {right} right, {wrong} wrong"
+    );
+    assert!(
+        solver.surplus_stops > 0 && solver.surplus_stops <= wrong,
+        "{name}: {} early stops of {wrong} wrong inertias",
+        solver.surplus_stops
+    );
+}
+
+#[test]
+fn surplus_stops_agree_with_the_eigenvalues_2d() {
+    surplus_stops_agree_with_the_eigenvalues("2d-min-time-rendezvous-avoidable");
+}
+
+#[test]
+fn surplus_stops_agree_with_the_eigenvalues_3d() {
+    surplus_stops_agree_with_the_eigenvalues("3d-min-time-rendezvous-unavoidable");
 }

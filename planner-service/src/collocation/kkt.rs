@@ -87,6 +87,16 @@ static BLOCK_FACTORIZATIONS: std::sync::atomic::AtomicUsize =
 /// under the floor, a non-finite entry), over the process.
 static FERAL_FALLBACKS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
+/// Factorisations block elimination stopped early on a certain surplus of negative
+/// eigenvalues (see [`Workspace::surplus`]), over the process.
+static SURPLUS_STOPS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// How many factorisations block elimination stopped early on a surplus of negative
+/// eigenvalues in this process (included in [`block_factorizations_total`]).
+pub fn surplus_stops_total() -> usize {
+    SURPLUS_STOPS.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 /// How many KKT factorisations block elimination has done in this process.
 pub fn block_factorizations_total() -> usize {
     BLOCK_FACTORIZATIONS.load(std::sync::atomic::Ordering::Relaxed)
@@ -339,6 +349,32 @@ struct Workspace {
     /// (`g_nz[n_first..n_first + g_nz_len[g]]`): the others add nothing.
     g_nz: Vec<usize>,
     g_nz_len: Vec<usize>,
+    /// The surplus test's set-up (see [`Workspace::surplus`]) for the KKT whose
+    /// multipliers are the indices from `first_dual` on (`usize::MAX`: none yet): whether
+    /// the pattern is a KKT's there (no entry couples two multipliers), each block's
+    /// multipliers, its groups' multipliers and their fill rank (set as they are
+    /// eliminated), the border's multipliers, and where the multipliers' diagonal entries
+    /// are in the input nonzeros.
+    first_dual: usize,
+    kkt_shaped: bool,
+    block_duals: Vec<usize>,
+    group_duals: Vec<usize>,
+    group_fill_rank: Vec<usize>,
+    border_duals: usize,
+    dual_diag: Vec<usize>,
+    /// Scratch for `M`'s inertia: a copy of it and its pivots.
+    m_copy: Vec<f64>,
+    m_piv: Vec<i32>,
+}
+
+/// What a factorisation found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Count {
+    /// It ran to the end: the number of negative eigenvalues.
+    Negative(usize),
+    /// It stopped where the matrix was certain to have more negative eigenvalues than its
+    /// multipliers (see [`Workspace::surplus`]).
+    Surplus,
 }
 
 /// Zeroes the lower triangle (with the diagonal) of the column-major `n × n` matrix `a`.
@@ -616,6 +652,12 @@ impl Workspace {
         ws.g_inv = vec![0.0; inv_len];
         ws.g_nz = vec![0; ws.g_nbrs.len()];
         ws.g_nz_len = vec![0; ws.groups.len()];
+        ws.first_dual = usize::MAX;
+        ws.block_duals = vec![0; count];
+        ws.group_duals = vec![0; count];
+        ws.group_fill_rank = vec![0; count];
+        ws.m_copy = vec![0.0; max_l * max_l];
+        ws.m_piv = vec![0; max_l];
         ws.rows = ia.iter().map(|&r| (r - 1) as u32).collect();
         ws.cols = ja.iter().map(|&c| (c - 1) as u32).collect();
         // Where an entry (r, c) outside the groups goes (lower triangle of each symmetric
@@ -708,6 +750,90 @@ impl Workspace {
         Some(ws)
     }
 
+    /// Sets the surplus test up for a KKT whose multipliers are the indices from
+    /// `first_dual` on (nothing to do when it already is). The test needs the KKT's shape:
+    /// no entry of the pattern couples two multipliers (`kkt_shaped`).
+    fn prepare_surplus(&mut self, first_dual: usize) {
+        if self.first_dual == first_dual {
+            return;
+        }
+        self.first_dual = first_dual;
+        let dual = |i: &usize| *i >= first_dual;
+        for (b, blk) in self.blocks.iter().enumerate() {
+            self.block_duals[b] = self.members[blk.first..blk.first + blk.n]
+                .iter()
+                .filter(|i| dual(i))
+                .count();
+            self.group_duals[b] = self.groups[blk.g_first..blk.g_first + blk.g_count]
+                .iter()
+                .map(|g| {
+                    self.g_members[g.first..g.first + g.q]
+                        .iter()
+                        .filter(|i| dual(i))
+                        .count()
+                })
+                .sum();
+        }
+        self.border_duals = self.border.iter().filter(|i| dual(i)).count();
+        self.dual_diag.clear();
+        self.kkt_shaped = true;
+        for (e, (&r, &c)) in self.rows.iter().zip(&self.cols).enumerate() {
+            let (r, c) = (r as usize, c as usize);
+            if r >= first_dual && c >= first_dual {
+                if r == c {
+                    self.dual_diag.push(e);
+                } else {
+                    self.kkt_shaped = false;
+                }
+            }
+        }
+    }
+
+    /// Whether the factorisation, after eliminating block `k` (and every group up to
+    /// block `k + 1`), is certain to end with more negative eigenvalues than the KKT has
+    /// multipliers, `negative` being the count so far and `m_link` holding
+    /// `M = E_Lᵀ Ã_kk⁻¹ E_L` (`l × l`, `l` the next block's links).
+    ///
+    /// Let `P` be the indices eliminated so far and `R` the rest, `Λ` the multipliers in
+    /// `R` outside the border. Cauchy interlacing gives `pos(K) ≤ pos(K_P) + pos(S) ≤
+    /// pos(K_P) + pos(S_ΛΛ) + |R| − |Λ|` (`S` the Schur complement on `R`), and `S_ΛΛ` is
+    /// the multipliers' own diagonal (`−δ_c ≤ 0`, checked) minus what `P` adds to it: the
+    /// next block's groups (nothing when a group's multiplier part is zero and square,
+    /// else at most its primal count: `group_fill_rank`) and the chain, `−C M Cᵀ`, with at
+    /// most `neg(M)` positive eigenvalues. With no zero pivot `pos(K_P) = |P| − negative`,
+    /// so `pos(K) < n = dim − m` (the inertia pounce expects) as soon as
+    /// `negative > m_P + m_border + group_fill_rank + neg(M)`: then the count cannot come
+    /// out right, whatever the rest of the factorisation finds.
+    ///
+    /// `base` is `m_P + m_border + group_fill_rank`; `m_copy`, `m_piv` and `work` are
+    /// scratch.
+    fn surplus(
+        negative: usize,
+        base: usize,
+        m_link: &[f64],
+        l: usize,
+        m_copy: &mut [f64],
+        m_piv: &mut [i32],
+        work: &mut [f64],
+    ) -> bool {
+        if negative <= base {
+            return false;
+        }
+        if negative > base + l {
+            return true;
+        }
+        // neg(M) from its own factorisation, when its pivots are clear of zero (else every
+        // one of its `l` eigenvalues may be negative).
+        let m = &mut m_copy[..l * l];
+        m.copy_from_slice(&m_link[..l * l]);
+        let scale = m.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let neg_m = match bunch_kaufman::factor(m, l, &mut m_piv[..l], work) {
+            Some(inertia) if inertia.min_pivot > 1e-10 * scale => inertia.negative,
+            _ => l,
+        };
+        negative > base + neg_m
+    }
+
     /// Assembles group `owner` (a block's `A`, `C` and `W`, or with `owner` = the block
     /// count the border's `S`) from `values`; `None` on a non-finite entry.
     fn assemble(&mut self, owner: usize, values: &[f64]) -> Option<()> {
@@ -741,9 +867,28 @@ impl Workspace {
     fn eliminate_groups(&mut self, b: usize, floor: f64) -> Option<usize> {
         let blk = self.blocks[b];
         let mut negative = 0;
+        let mut fill_rank = 0;
         for gi in blk.g_first..blk.g_first + blk.g_count {
             let g = self.groups[gi];
             let (q, nn) = (g.q, g.nn);
+            if self.first_dual != usize::MAX {
+                // The rank its elimination may add to the multipliers' diagonal block:
+                // none when its multiplier part is zero and as large as its primal part
+                // (then G⁻¹'s primal block is zero), else at most its primal count.
+                let members = &self.g_members[g.first..g.first + q];
+                let duals = members.iter().filter(|&&i| i >= self.first_dual).count();
+                let gm = &self.dense[g.g_off..g.g_off + q * q];
+                let zero = (0..q).all(|j| {
+                    (j..q).all(|i| {
+                        members[i] < self.first_dual
+                            || members[j] < self.first_dual
+                            || gm[i + j * q] == 0.0
+                    })
+                });
+                if !(zero && 2 * duals == q) {
+                    fill_rank += q - duals;
+                }
+            }
             let bm = &mut self.g_b[..q * nn];
             bm.copy_from_slice(&self.dense[g.g_off + q * q..g.g_off + q * q + q * nn]);
             let gm = &mut self.dense[g.g_off..g.g_off + q * q];
@@ -802,6 +947,7 @@ impl Workspace {
             if largest.is_nan() || largest > GROUP_GROWTH_MAX {
                 return None;
             }
+
             let (y, bm, nz) = (&*y, &*bm, &nz[..n_nz]);
             let fill = &self.g_fill[g.f_first..g.f_first + nn * (nn + 1) / 2];
             for (jj, &j) in nz.iter().enumerate() {
@@ -815,20 +961,31 @@ impl Workspace {
                 }
             }
         }
+        self.group_fill_rank[b] = fill_rank;
         Some(negative)
     }
 
     /// Factorises the matrix with nonzeros `values`. `None`: a non-finite entry, a pivot
-    /// under `floor` or a zero pivot column; otherwise the number of negative eigenvalues.
-    fn factor(&mut self, values: &[f64], floor: f64) -> Option<usize> {
+    /// under `floor` or a zero pivot column; otherwise the number of negative eigenvalues,
+    /// or with `test` (the surplus test set up by [`Workspace::prepare_surplus`]) possibly
+    /// [`Count::Surplus`], before the end.
+    fn factor(&mut self, values: &[f64], floor: f64, test: bool) -> Option<Count> {
         let count = self.blocks.len();
         self.k_max = 0.0;
         self.assemble(count, values)?;
         let nb = self.border.len();
         let mut negative = 0;
+        // The test holds for a KKT's shape, with the multipliers' diagonal `−δ_c ≤ 0`.
+        let test = test
+            && self.first_dual != usize::MAX
+            && self.kkt_shaped
+            && self.dual_diag.iter().all(|&e| values[e] <= 0.0);
+        // Multipliers eliminated so far.
+        let mut m_p = 0;
         if count > 0 {
             self.assemble(0, values)?;
             negative += self.eliminate_groups(0, floor)?;
+            m_p += self.group_duals[0];
         }
         for k in 0..count {
             // The next block is assembled now, and its groups eliminated (they update this
@@ -836,6 +993,7 @@ impl Workspace {
             if k + 1 < count {
                 self.assemble(k + 1, values)?;
                 negative += self.eliminate_groups(k + 1, floor)?;
+                m_p += self.group_duals[k + 1];
             }
             let (a_all, rest) = self.dense.split_at_mut(self.c_base);
             let (c_all, rest) = rest.split_at_mut(self.w_base - self.c_base);
@@ -871,7 +1029,13 @@ impl Workspace {
             // M = E_Lᵀ Ã_kk⁻¹ E_L = G_Lᵀ V_L and E_Lᵀ Ã_kk⁻¹ W_k = G_Lᵀ V;
             // Ã_{k+1} -= C M Cᵀ and W_{k+1} -= C E_Lᵀ Ã_kk⁻¹ W_k.
             let l = next.l;
+            m_p += self.block_duals[k];
             if l == 0 {
+                let base =
+                    m_p + self.border_duals + self.group_fill_rank.get(k + 1).map_or(0, |&f| f);
+                if test && negative > base {
+                    return Some(Count::Surplus);
+                }
                 continue;
             }
             let links = &self.links[next.l_first..next.l_first + l];
@@ -888,6 +1052,20 @@ impl Workspace {
                 for (i, gi) in gl.chunks_exact(n).enumerate() {
                     mm[i + j * l] = bunch_kaufman::dot(gi, vj);
                 }
+            }
+            let base = m_p + self.border_duals + self.group_fill_rank[k + 1];
+            if test
+                && Self::surplus(
+                    negative,
+                    base,
+                    mm,
+                    l,
+                    &mut self.m_copy,
+                    &mut self.m_piv,
+                    &mut self.bk_work,
+                )
+            {
+                return Some(Count::Surplus);
             }
             let yl = &mut self.y_link[..l * m];
             for (j, vj) in v.chunks_exact(n).enumerate() {
@@ -945,7 +1123,7 @@ impl Workspace {
             let piv = &mut self.piv[self.members.len()..];
             negative += factor_above(&mut *s, nb, piv, &mut self.bk_work, floor)?;
         }
-        Some(negative)
+        Some(Count::Negative(negative))
     }
 
     /// Solves `K x = b` in place (`b` in KKT order, `K` with nonzeros `values`), with up
@@ -1139,6 +1317,8 @@ fn half_solve(a: &[f64], n: usize, piv: &[i32], g: &mut [f64], v: &mut [f64], nc
 enum Factored {
     None,
     Blocks,
+    /// Block elimination stopped on a certain surplus ([`Count::Surplus`]).
+    Stopped,
     Feral,
 }
 
@@ -1162,6 +1342,8 @@ pub struct StructuredKkt {
     /// Factorisations by the blocks and by FERAL (for tests and diagnostics).
     pub block_factorizations: usize,
     pub feral_factorizations: usize,
+    /// Of `block_factorizations`, those stopped on a surplus of negative eigenvalues.
+    pub surplus_stops: usize,
 }
 
 impl StructuredKkt {
@@ -1182,6 +1364,7 @@ impl StructuredKkt {
             switched: false,
             block_factorizations: 0,
             feral_factorizations: 0,
+            surplus_stops: 0,
         }
     }
 
@@ -1269,7 +1452,13 @@ impl SparseSymLinearSolverInterface for StructuredKkt {
             return self.feral_solve(new_matrix, ia, ja, nrhs, rhs_vals, check, expected);
         };
         if new_matrix {
-            let mut neg = ws.factor(&self.values, self.floor);
+            // The surplus test needs the multipliers' count: the KKT's last `expected`
+            // indices.
+            let test = check && (0..=self.dim as Index).contains(&expected);
+            if test {
+                ws.prepare_surplus(self.dim - expected as usize);
+            }
+            let mut neg = ws.factor(&self.values, self.floor, test);
             let grouped = !ws.groups.is_empty();
             self.on_plain = false;
             if neg.is_none() && grouped {
@@ -1282,7 +1471,10 @@ impl SparseSymLinearSolverInterface for StructuredKkt {
                         .and_then(|l| Workspace::new(self.dim, ia, ja, &l.blocks, &[]));
                 }
                 if let Some(plain) = self.plain.as_mut() {
-                    neg = plain.factor(&self.values, self.floor);
+                    if test {
+                        plain.prepare_surplus(self.dim - expected as usize);
+                    }
+                    neg = plain.factor(&self.values, self.floor, test);
                     self.on_plain = neg.is_some();
                     if self.on_plain {
                         PLAIN_FACTORIZATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -1295,15 +1487,31 @@ impl SparseSymLinearSolverInterface for StructuredKkt {
             };
             self.block_factorizations += 1;
             BLOCK_FACTORIZATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            self.factored = Factored::Blocks;
-            self.negevals = neg as Index;
-            if check && self.negevals != expected {
-                return ESymSolverStatus::WrongInertia;
+            match neg {
+                Count::Surplus => {
+                    SURPLUS_STOPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    self.surplus_stops += 1;
+                    self.factored = Factored::Stopped;
+                    // More than expected (pounce reads only which side of it the count
+                    // is); the exact count was not taken.
+                    self.negevals = expected + 1;
+                    return ESymSolverStatus::WrongInertia;
+                }
+                Count::Negative(neg) => {
+                    self.factored = Factored::Blocks;
+                    self.negevals = neg as Index;
+                    if check && self.negevals != expected {
+                        return ESymSolverStatus::WrongInertia;
+                    }
+                }
             }
         }
         match self.factored {
             Factored::Feral => self.feral_solve(false, ia, ja, nrhs, rhs_vals, check, expected),
             Factored::None => ESymSolverStatus::FatalError,
+            // A solve with the matrix whose factorisation stopped (pounce perturbs after a
+            // wrong inertia, but should it solve): the whole factorisation, unchecked.
+            Factored::Stopped => self.multi_solve(true, ia, ja, nrhs, rhs_vals, false, expected),
             Factored::Blocks => {
                 let dim = self.dim;
                 let ws = match self.plain.as_mut() {
@@ -1717,6 +1925,43 @@ mod tests {
             expected_neg.is_some(),
             expected_neg.unwrap_or(0) as Index,
         )
+    }
+
+    /// The early stop on a surplus of negative eigenvalues, on a three-index KKT
+    /// `[[h, 0, c], [0, 2, 1], [c, 1, 0]]` (primal `x` in block 0; primal `y` and the one
+    /// multiplier in block 1): with `h = −1` block 0 alone has a negative eigenvalue more
+    /// than multipliers, but through the link (`c = 1`, `M = 1/h < 0`) the next block makes
+    /// up for it: the matrix's inertia is right (determinant −1, trace 1: one negative
+    /// eigenvalue), so the factorisation must not stop. Without the link (`c` not in the
+    /// pattern) nothing can: it stops, and reports the wrong inertia with more negative
+    /// eigenvalues than multipliers (the matrix has two).
+    #[test]
+    fn a_surplus_stops_only_when_the_rest_cannot_make_up_for_it() {
+        for (linked, status, stops) in [
+            (true, ESymSolverStatus::Success, 0),
+            (false, ESymSolverStatus::WrongInertia, 1),
+        ] {
+            let (mut ia, mut ja, mut va) = (
+                vec![1, 2, 3, 3],
+                vec![1, 2, 2, 3],
+                vec![-1.0, 2.0, 1.0, 0.0],
+            );
+            if linked {
+                ia.push(3);
+                ja.push(1);
+                va.push(1.0);
+            }
+            let mut solver = StructuredKkt::new(Some(KktLabels::plain(vec![0, 1, 1])), feral_cfg());
+            let mut x = vec![1.0; 3];
+            let got = solve_with(&mut solver, &ia, &ja, &va, &mut x, 1, Some(1));
+            assert!(solver.is_structured());
+            assert_eq!(
+                (got, solver.surplus_stops),
+                (status, stops),
+                "linked: {linked}"
+            );
+            assert_eq!(solver.number_of_neg_evals() > 1, !linked);
+        }
     }
 
     /// Block elimination on random arrowheads, plain and chained (indefinite blocks and
