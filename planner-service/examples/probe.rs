@@ -235,7 +235,11 @@ fn main() {
                         .iter()
                         .map(|c| format!("{:.3}", c / best))
                         .collect();
-                    println!("RANKED {name} {seed} [{}]", rel.join(", "));
+                    println!(
+                        "RANKED {name} {seed} [{}] fin {:?}",
+                        rel.join(", "),
+                        out.nlp.finalists
+                    );
                 }
             }
             if seed == 1 {

@@ -37,6 +37,52 @@ pub struct GenTMatrixSpace {
     n_cols: Index,
     irows: Vec<Index>,
     jcols: Vec<Index>,
+    /// Every index is in `1..=n_rows` / `1..=n_cols` (checked once, here), so the
+    /// products may index without bounds checks (wingman patch).
+    in_bounds: bool,
+}
+
+/// Whether every 1-based index of `idx` is in `1..=n` (wingman patch).
+fn all_in(idx: &[Index], n: Index) -> bool {
+    idx.iter().all(|&i| i >= 1 && i <= n)
+}
+
+/// `y[r_k - 1] += alpha * v_k * x[c_k - 1]` over the triplets `(r, c, v)`, in their order
+/// (wingman patch: the loop the products share). With `trusted` (every row index at
+/// most `y.len()`, every column index at most `x.len()`, none below 1) it indexes
+/// without bounds checks; `alpha == 1` skips the factor, which changes no bit
+/// (`1 · v == v`).
+#[inline]
+fn scatter_gather(
+    rows: &[Index],
+    cols: &[Index],
+    vals: &[Number],
+    alpha: Number,
+    x: &[Number],
+    y: &mut [Number],
+    trusted: bool,
+) {
+    let triplets = rows.iter().zip(cols.iter()).zip(vals.iter());
+    if !trusted {
+        for ((&r, &c), &v) in triplets {
+            y[(r - 1) as usize] += alpha * v * x[(c - 1) as usize];
+        }
+    } else if alpha == 1.0 {
+        for ((&r, &c), &v) in triplets {
+            // SAFETY: `trusted`: 1 <= r <= y.len(), 1 <= c <= x.len().
+            unsafe {
+                *y.get_unchecked_mut((r - 1) as usize) += v * x.get_unchecked((c - 1) as usize);
+            }
+        }
+    } else {
+        for ((&r, &c), &v) in triplets {
+            // SAFETY: as above.
+            unsafe {
+                *y.get_unchecked_mut((r - 1) as usize) +=
+                    alpha * v * x.get_unchecked((c - 1) as usize);
+            }
+        }
+    }
 }
 
 impl GenTMatrixSpace {
@@ -46,11 +92,13 @@ impl GenTMatrixSpace {
             jcols.len(),
             "GenTMatrixSpace: irows/jcols length mismatch"
         );
+        let in_bounds = all_in(&irows, n_rows) && all_in(&jcols, n_cols);
         Rc::new(Self {
             n_rows,
             n_cols,
             irows,
             jcols,
+            in_bounds,
         })
     }
 
@@ -254,10 +302,10 @@ impl Matrix for GenTMatrix {
                 }
             } else {
                 let xvals = dx.values();
-                for ((&irow, &jcol), &val) in irows.iter().zip(jcols.iter()).zip(self.values.iter())
-                {
-                    yvals[(irow - 1) as usize] += alpha * val * xvals[(jcol - 1) as usize];
-                }
+                let trusted = self.space.in_bounds
+                    && yvals.len() >= self.space.n_rows as usize
+                    && xvals.len() >= self.space.n_cols as usize;
+                scatter_gather(irows, jcols, &self.values, alpha, xvals, yvals, trusted);
             }
             return;
         }
@@ -303,10 +351,10 @@ impl Matrix for GenTMatrix {
                 }
             } else {
                 let xvals = dx.values();
-                for ((&irow, &jcol), &val) in irows.iter().zip(jcols.iter()).zip(self.values.iter())
-                {
-                    yvals[(jcol - 1) as usize] += alpha * val * xvals[(irow - 1) as usize];
-                }
+                let trusted = self.space.in_bounds
+                    && yvals.len() >= self.space.n_cols as usize
+                    && xvals.len() >= self.space.n_rows as usize;
+                scatter_gather(jcols, irows, &self.values, alpha, xvals, yvals, trusted);
             }
             return;
         }
@@ -337,6 +385,18 @@ impl Matrix for GenTMatrix {
         dv.ensure_storage();
         let irows = self.irows();
         let vec_vals = dv.values_mut();
+        if self.space.in_bounds && vec_vals.len() >= self.space.n_rows as usize {
+            // Wingman patch: the same loop without bounds checks.
+            for (&irow, &val) in irows.iter().zip(self.values.iter()) {
+                // SAFETY: 1 <= irow <= n_rows <= vec_vals.len() (`in_bounds`).
+                let slot = unsafe { vec_vals.get_unchecked_mut((irow - 1) as usize) };
+                let f = val.abs();
+                if f > *slot {
+                    *slot = f;
+                }
+            }
+            return;
+        }
         for (&irow, &val) in irows.iter().zip(self.values.iter()) {
             let i = (irow - 1) as usize;
             let f = val.abs();
@@ -375,6 +435,8 @@ pub struct SymTMatrixSpace {
     dim: Index,
     irows: Vec<Index>,
     jcols: Vec<Index>,
+    /// Every index is in `1..=dim` (wingman patch, see [`GenTMatrixSpace`]).
+    in_bounds: bool,
 }
 
 impl SymTMatrixSpace {
@@ -384,7 +446,13 @@ impl SymTMatrixSpace {
             jcols.len(),
             "SymTMatrixSpace: irows/jcols length mismatch"
         );
-        Rc::new(Self { dim, irows, jcols })
+        let in_bounds = all_in(&irows, dim) && all_in(&jcols, dim);
+        Rc::new(Self {
+            dim,
+            irows,
+            jcols,
+            in_bounds,
+        })
     }
 
     pub fn dim(&self) -> Index {
@@ -529,12 +597,34 @@ impl Matrix for SymTMatrix {
                 }
             } else {
                 let xvals = dx.values();
-                for ((&i_one, &j_one), &val) in irn.iter().zip(jcn.iter()).zip(self.values.iter()) {
-                    let i = (i_one - 1) as usize;
-                    let j = (j_one - 1) as usize;
-                    yvals[i] += alpha * val * xvals[j];
-                    if i_one != j_one {
-                        yvals[j] += alpha * val * xvals[i];
+                let dim = self.space.dim as usize;
+                if self.space.in_bounds && yvals.len() >= dim && xvals.len() >= dim {
+                    // Wingman patch: the same loop without bounds checks (every index in
+                    // `1..=dim`, checked when the space was made).
+                    for ((&i_one, &j_one), &val) in
+                        irn.iter().zip(jcn.iter()).zip(self.values.iter())
+                    {
+                        let i = (i_one - 1) as usize;
+                        let j = (j_one - 1) as usize;
+                        // SAFETY: i, j < dim <= yvals.len(), xvals.len().
+                        unsafe {
+                            *yvals.get_unchecked_mut(i) += alpha * val * xvals.get_unchecked(j);
+                            if i_one != j_one {
+                                *yvals.get_unchecked_mut(j) +=
+                                    alpha * val * xvals.get_unchecked(i);
+                            }
+                        }
+                    }
+                } else {
+                    for ((&i_one, &j_one), &val) in
+                        irn.iter().zip(jcn.iter()).zip(self.values.iter())
+                    {
+                        let i = (i_one - 1) as usize;
+                        let j = (j_one - 1) as usize;
+                        yvals[i] += alpha * val * xvals[j];
+                        if i_one != j_one {
+                            yvals[j] += alpha * val * xvals[i];
+                        }
                     }
                 }
             }
@@ -712,6 +802,91 @@ mod tests {
         // [1*5 + 2*11, 3*7 + 4*11] = [27, 65]
         let dy = y.as_any().downcast_ref::<DenseVector>().unwrap();
         assert_eq!(dy.values(), &[27.0, 65.0]);
+    }
+
+    /// Wingman patch: the products without bounds checks (and `alpha == 1` without the
+    /// factor) give the same bits as the checked formula `y[r] += alpha * v * x[c]` in
+    /// triplet order, on random triplets with repeated entries, for several `alpha` and
+    /// `beta`; a space with an index out of range is not trusted (`in_bounds` false), so
+    /// its product panics as the checked loop does.
+    #[test]
+    fn unchecked_products_match_the_checked_formula() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let (n_rows, n_cols, nnz) = (7usize, 5usize, 40usize);
+        let rows: Vec<Index> = (0..nnz).map(|_| (next() % n_rows as u64) as Index + 1).collect();
+        let cols: Vec<Index> = (0..nnz).map(|_| (next() % n_cols as u64) as Index + 1).collect();
+        let vals: Vec<Number> = (0..nnz).map(|_| (next() % 2001) as f64 / 97.0 - 10.0).collect();
+        let xr: Vec<Number> = (0..n_rows).map(|_| (next() % 1001) as f64 / 13.0 - 37.0).collect();
+        let xc: Vec<Number> = (0..n_cols).map(|_| (next() % 1001) as f64 / 13.0 - 37.0).collect();
+        let space = GenTMatrixSpace::new(n_rows as Index, n_cols as Index, rows.clone(), cols.clone());
+        assert!(space.in_bounds);
+        let mut m = GenTMatrix::new(space);
+        m.set_values(&vals);
+        let sym_rows: Vec<Index> = rows.iter().zip(&cols).map(|(&r, &c)| r.max(c)).collect();
+        let sym_cols: Vec<Index> = rows.iter().zip(&cols).map(|(&r, &c)| r.min(c)).collect();
+        let sym_space = SymTMatrixSpace::new(n_rows as Index, sym_rows.clone(), sym_cols.clone());
+        assert!(sym_space.in_bounds);
+        let mut sym = SymTMatrix::new(sym_space);
+        sym.set_values(&vals);
+        for (alpha, beta) in [(1.0, 0.0), (1.0, 0.5), (-0.5, 0.0), (2.5, 1.5)] {
+            let y0: Vec<Number> = (0..n_rows).map(|i| i as f64 * 0.25 - 1.0).collect();
+            let mut want: Vec<Number> = y0.iter().map(|v| if beta != 0.0 { v * beta } else { 0.0 }).collect();
+            for k in 0..nnz {
+                want[rows[k] as usize - 1] += alpha * vals[k] * xc[cols[k] as usize - 1];
+            }
+            let mut y = dvec_box(&y0);
+            m.mult_vector(alpha, dvec_box(&xc).as_dyn_vector(), beta, y.as_mut());
+            let got = y.as_any().downcast_ref::<DenseVector>().unwrap().values().to_vec();
+            assert_eq!(got.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), want.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+
+            let yc0: Vec<Number> = (0..n_cols).map(|i| 1.0 - i as f64 * 0.5).collect();
+            let mut want: Vec<Number> = yc0.iter().map(|v| if beta != 0.0 { v * beta } else { 0.0 }).collect();
+            for k in 0..nnz {
+                want[cols[k] as usize - 1] += alpha * vals[k] * xr[rows[k] as usize - 1];
+            }
+            let mut y = dvec_box(&yc0);
+            m.trans_mult_vector(alpha, dvec_box(&xr).as_dyn_vector(), beta, y.as_mut());
+            let got = y.as_any().downcast_ref::<DenseVector>().unwrap().values().to_vec();
+            assert_eq!(got.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), want.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+
+            let mut want: Vec<Number> = y0.iter().map(|v| if beta != 0.0 { v * beta } else { 0.0 }).collect();
+            for k in 0..nnz {
+                let (i, j) = (sym_rows[k] as usize - 1, sym_cols[k] as usize - 1);
+                want[i] += alpha * vals[k] * xr[j];
+                if i != j {
+                    want[j] += alpha * vals[k] * xr[i];
+                }
+            }
+            let mut y = dvec_box(&y0);
+            sym.mult_vector(alpha, dvec_box(&xr).as_dyn_vector(), beta, y.as_mut());
+            let got = y.as_any().downcast_ref::<DenseVector>().unwrap().values().to_vec();
+            assert_eq!(got.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), want.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+        }
+        let mut want = vec![0.0f64; n_rows];
+        for k in 0..nnz {
+            let r = rows[k] as usize - 1;
+            want[r] = want[r].max(vals[k].abs());
+        }
+        let mut norms = dvec_box(&vec![0.0; n_rows]);
+        m.compute_row_amax(norms.as_mut(), true);
+        assert_eq!(norms.as_any().downcast_ref::<DenseVector>().unwrap().values(), &want[..]);
+    }
+
+    #[test]
+    #[should_panic]
+    fn an_index_out_of_range_is_not_trusted() {
+        let space = GenTMatrixSpace::new(2, 2, vec![1, 3], vec![1, 2]);
+        assert!(!space.in_bounds);
+        let mut m = GenTMatrix::new(space);
+        m.set_values(&[1.0, 2.0]);
+        let mut y = dvec_box(&[0.0, 0.0]);
+        m.mult_vector(1.0, dvec_box(&[1.0, 1.0]).as_dyn_vector(), 0.0, y.as_mut());
     }
 
     #[test]
