@@ -2255,13 +2255,20 @@ impl OrigIpoptNlp {
         let mut jac_c = GenTMatrix::new(Rc::clone(&self.jac_c_space));
         {
             let cs = self.c_scale.borrow();
-            let irows = self.jac_c_space.irows().to_vec();
+            // wingman patch: the rows borrowed, not copied, and walked beside the values
+            // (the same products).
+            let irows = self.jac_c_space.irows();
             let vs = jac_c.values_mut();
-            for (k, &src) in self.jac_c_entry_in_g.iter().enumerate() {
+            debug_assert_eq!(vs.len(), self.jac_c_entry_in_g.len());
+            for ((vk, &src), &irow) in vs
+                .iter_mut()
+                .zip(self.jac_c_entry_in_g.iter())
+                .zip(irows)
+            {
                 let raw = full_vals[src as usize];
-                vs[k] = match cs.as_ref() {
+                *vk = match cs.as_ref() {
                     // irows are 1-based.
-                    Some(v) => raw * v[(irows[k] - 1) as usize],
+                    Some(v) => raw * v[(irow - 1) as usize],
                     None => raw,
                 };
             }
@@ -2296,12 +2303,19 @@ impl OrigIpoptNlp {
         let mut jac_d = GenTMatrix::new(Rc::clone(&self.jac_d_space));
         {
             let ds = self.d_scale.borrow();
-            let irows = self.jac_d_space.irows().to_vec();
+            // wingman patch: the rows borrowed, not copied, and walked beside the values
+            // (the same products).
+            let irows = self.jac_d_space.irows();
             let vs = jac_d.values_mut();
-            for (k, &src) in self.jac_d_entry_in_g.iter().enumerate() {
+            debug_assert_eq!(vs.len(), self.jac_d_entry_in_g.len());
+            for ((vk, &src), &irow) in vs
+                .iter_mut()
+                .zip(self.jac_d_entry_in_g.iter())
+                .zip(irows)
+            {
                 let raw = full_vals[src as usize];
-                vs[k] = match ds.as_ref() {
-                    Some(v) => raw * v[(irows[k] - 1) as usize],
+                *vk = match ds.as_ref() {
+                    Some(v) => raw * v[(irow - 1) as usize],
                     None => raw,
                 };
             }
@@ -2396,8 +2410,9 @@ impl OrigIpoptNlp {
         // `h_entry_in_full` always has length `kept` (identity when no
         // fixed-var filtering, sparse selection otherwise).
         debug_assert_eq!(kept, self.h_entry_in_full.len());
-        for (k, &src) in self.h_entry_in_full.iter().enumerate() {
-            h_vals[k] = full_vals[src as usize];
+        // wingman patch: walked beside the values (the same copies).
+        for (hk, &src) in h_vals.iter_mut().zip(self.h_entry_in_full.iter()) {
+            *hk = full_vals[src as usize];
         }
         let reuse = self.const_deriv.hessian && all_finite(h.values());
         let result: Rc<dyn SymMatrix> = Rc::new(h);
