@@ -747,6 +747,14 @@ impl Workspace {
             ws.by_owner[fill[o]] = i as u32;
             fill[o] += 1;
         }
+        // What the unchecked loops of `assemble` and `solve_refined` rely on: every
+        // destination inside `dense`, every pattern index (checked above) below `dim`.
+        if ws.dest.iter().any(|&d| d >= ws.dense.len())
+            || ws.rows.iter().chain(&ws.cols).any(|&i| i as usize >= dim)
+            || ws.rhs.len() != dim
+        {
+            return None;
+        }
         Some(ws)
     }
 
@@ -851,11 +859,19 @@ impl Workspace {
         }
         let mut finite = true;
         let group = &self.by_owner[self.owner_start[owner]..self.owner_start[owner + 1]];
+        // `by_owner` holds each nonzero's index once (< dest.len()), and `new` checked
+        // every `dest` inside `dense`.
+        assert!(values.len() >= self.dest.len(), "one value per nonzero");
         for &i in group {
-            let v = values[i as usize];
-            self.dense[self.dest[i as usize]] += v;
-            self.k_max = self.k_max.max(v.abs());
-            finite &= v.is_finite();
+            // SAFETY: i < dest.len() <= values.len(); dest[i] < dense.len() (`new`).
+            unsafe {
+                let v = *values.get_unchecked(i as usize);
+                *self
+                    .dense
+                    .get_unchecked_mut(*self.dest.get_unchecked(i as usize)) += v;
+                self.k_max = self.k_max.max(v.abs());
+                finite &= v.is_finite();
+            }
         }
         finite.then_some(())
     }
@@ -1155,11 +1171,18 @@ impl Workspace {
         let b_max = self.rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for _ in 0..REFINE_STEPS {
             self.res.copy_from_slice(&self.rhs);
+            assert!(
+                b.len() == self.res.len(),
+                "one right-hand side of the KKT's order"
+            );
             for ((&r, &c), &v) in self.rows.iter().zip(&self.cols).zip(values) {
                 let (r, c) = (r as usize, c as usize);
-                self.res[r] -= v * b[c];
-                if r != c {
-                    self.res[c] -= v * b[r];
+                // SAFETY: r, c < dim (`new`) = res.len() = b.len().
+                unsafe {
+                    *self.res.get_unchecked_mut(r) -= v * b.get_unchecked(c);
+                    if r != c {
+                        *self.res.get_unchecked_mut(c) -= v * b.get_unchecked(r);
+                    }
                 }
             }
             let r_max = self.res.iter().fold(0.0f64, |m, v| m.max(v.abs()));
