@@ -747,9 +747,14 @@ impl Workspace {
             ws.by_owner[fill[o]] = i as u32;
             fill[o] += 1;
         }
-        // What the unchecked loops of `assemble` and `solve_refined` rely on: every
-        // destination inside `dense`, every pattern index (checked above) below `dim`.
-        if ws.dest.iter().any(|&d| d >= ws.dense.len())
+        // What the unchecked loops of `assemble`, `eliminate_groups` and `solve_refined`
+        // rely on: every destination (of a nonzero, of a group's fill) inside `dense`,
+        // every pattern index (checked above) below `dim`.
+        if ws
+            .dest
+            .iter()
+            .chain(&ws.g_fill)
+            .any(|&d| d >= ws.dense.len())
             || ws.rows.iter().chain(&ws.cols).any(|&i| i as usize >= dim)
             || ws.rhs.len() != dim
         {
@@ -982,9 +987,15 @@ impl Workspace {
                 let fill = &fill[col - j..];
                 if q == 2 {
                     let (y0, y1) = (yj[0], yj[1]);
+                    let (bm, fill) = (&bm[..2 * nn], &fill[..nn]);
                     for &i in &nz[jj..] {
-                        let v = bm[2 * i] * y0 + bm[2 * i + 1] * y1;
-                        self.dense[fill[i]] -= v;
+                        // SAFETY: i < nn (a neighbour's position), so 2i + 1 < bm.len()
+                        // and i < fill.len(); every fill destination is inside `dense`
+                        // (checked in `new`).
+                        unsafe {
+                            let v = bm.get_unchecked(2 * i) * y0 + bm.get_unchecked(2 * i + 1) * y1;
+                            *self.dense.get_unchecked_mut(*fill.get_unchecked(i)) -= v;
+                        }
                     }
                 } else {
                     for &i in &nz[jj..] {
