@@ -490,8 +490,29 @@ impl Vector for DenseVector {
         if self.homogeneous {
             return self.scalar.abs();
         }
-        let i = blas1::iamax(&self.values, 1, self.space.dim()) as usize;
-        self.values[i].abs()
+        // wingman patch: the value `iamax` would pick, in four lanes. `iamax` keeps the
+        // first entry's magnitude and takes each later one that is larger (`>`: a NaN
+        // never is), so the answer is the largest magnitude with NaNs skipped, or NaN
+        // when the first entry is one. `f64::max` also skips a NaN, and the largest of a
+        // set of magnitudes is the same bits in any order.
+        let v = &self.values[..self.space.dim() as usize];
+        let first = v[0].abs();
+        if first.is_nan() {
+            return first;
+        }
+        let mut lanes = [first; 4];
+        let chunks = v[1..].chunks_exact(4);
+        let rest = chunks.remainder();
+        for c in chunks {
+            for q in 0..4 {
+                lanes[q] = lanes[q].max(c[q].abs());
+            }
+        }
+        let mut m = lanes[0].max(lanes[1]).max(lanes[2].max(lanes[3]));
+        for x in rest {
+            m = m.max(x.abs());
+        }
+        m
     }
 
     fn set_impl(&mut self, value: Number) {
@@ -981,6 +1002,48 @@ mod tests {
         let mut v = DenseVector::new(Rc::clone(space));
         v.set_values(vals);
         v
+    }
+
+    /// Wingman patch: the four-lane `amax` gives the same bits as the magnitude of the
+    /// entry `blas1::iamax` picks, on vectors of 1 to 13 entries with negatives, zeros
+    /// of both signs, repeated maxima and NaNs (first, elsewhere, everywhere).
+    #[test]
+    fn amax_in_lanes_matches_iamax() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for n in 1..=13usize {
+            for case in 0..40 {
+                let mut v: Vec<Number> = (0..n)
+                    .map(|_| match next() % 7 {
+                        0 => 0.0,
+                        1 => -0.0,
+                        2 => 3.5,
+                        3 => -3.5,
+                        _ => (next() % 2001) as f64 / 37.0 - 27.0,
+                    })
+                    .collect();
+                if case % 5 == 1 {
+                    v[(next() % n as u64) as usize] = f64::NAN;
+                }
+                if case % 10 == 3 {
+                    v[0] = f64::NAN;
+                }
+                if case == 7 {
+                    v.iter_mut().for_each(|x| *x = f64::NAN);
+                }
+                let want = v[crate::blas1::iamax(&v, 1, n as Index) as usize].abs();
+                let space = DenseVectorSpace::new(n as Index);
+                let mut x = space.make_new_dense();
+                x.set_values(&v);
+                let got = x.amax();
+                assert_eq!(got.to_bits(), want.to_bits(), "{v:?}");
+            }
+        }
     }
 
     /// wingman patch: a vector materialised in a dropped vector's buffer starts as a fresh
