@@ -756,7 +756,7 @@ impl Workspace {
             .chain(&ws.g_fill)
             .any(|&d| d >= ws.dense.len())
             || ws.rows.iter().chain(&ws.cols).any(|&i| i as usize >= dim)
-            || ws.rhs.len() != dim
+            || ws.res.len() != dim
         {
             return None;
         }
@@ -961,6 +961,14 @@ impl Workspace {
                     // sum starts from -0.0, which adds nothing).
                     yj[0] = inv[0] * bj[0] + inv[2] * bj[1];
                     yj[1] = inv[1] * bj[0] + inv[3] * bj[1];
+                } else if q == 4 {
+                    // The 3-D groups, likewise.
+                    for (r, yr) in yj.iter_mut().enumerate() {
+                        *yr = inv[r] * bj[0]
+                            + inv[r + 4] * bj[1]
+                            + inv[r + 8] * bj[2]
+                            + inv[r + 12] * bj[3];
+                    }
                 } else {
                     for (r, yr) in yj.iter_mut().enumerate() {
                         *yr = (0..q).map(|c| inv[r + c * q] * bj[c]).sum();
@@ -994,6 +1002,18 @@ impl Workspace {
                         // (checked in `new`).
                         unsafe {
                             let v = bm.get_unchecked(2 * i) * y0 + bm.get_unchecked(2 * i + 1) * y1;
+                            *self.dense.get_unchecked_mut(*fill.get_unchecked(i)) -= v;
+                        }
+                    }
+                } else if q == 4 {
+                    let (y0, y1, y2, y3) = (yj[0], yj[1], yj[2], yj[3]);
+                    let (bm, fill) = (&bm[..4 * nn], &fill[..nn]);
+                    for &i in &nz[jj..] {
+                        let bi = &bm[4 * i..4 * i + 4];
+                        let v = bi[0] * y0 + bi[1] * y1 + bi[2] * y2 + bi[3] * y3;
+                        // SAFETY: i < nn = fill.len(); every fill destination is inside
+                        // `dense` (checked in `new`).
+                        unsafe {
                             *self.dense.get_unchecked_mut(*fill.get_unchecked(i)) -= v;
                         }
                     }
