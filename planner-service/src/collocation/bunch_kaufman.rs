@@ -277,10 +277,18 @@ fn sub_weighted_columns(a: &[f64], n: usize, base: usize, coef: &[f64], out: &mu
     #[inline(always)]
     fn strip<const R: usize>(a: &[f64], n: usize, from: usize, coef: &[f64], out: &mut [f64]) {
         let mut acc = [0.0f64; R];
+        if coef.is_empty() {
+            return;
+        }
+        // Every column read lies inside `a`: checked once for the last (the furthest).
+        assert!(
+            from + (coef.len() - 1) * n + R <= a.len(),
+            "R rows of every column"
+        );
+        let base = a[from..].as_ptr();
         for (p, &c) in coef.iter().enumerate() {
-            let col: &[f64; R] = a[from + p * n..from + p * n + R]
-                .try_into()
-                .expect("R rows");
+            // SAFETY: from + p·n + R <= from + (coef.len() − 1)·n + R <= a.len() (above).
+            let col = unsafe { &*(base.add(p * n) as *const [f64; R]) };
             for q in 0..R {
                 acc[q] += col[q] * c;
             }
