@@ -352,14 +352,16 @@ struct Workspace {
     /// The surplus test's set-up (see [`Workspace::surplus`]) for the KKT whose
     /// multipliers are the indices from `first_dual` on (`usize::MAX`: none yet): whether
     /// the pattern is a KKT's there (no entry couples two multipliers), each block's
-    /// multipliers, its groups' multipliers and their fill rank (set as they are
-    /// eliminated), the border's multipliers, and where the multipliers' diagonal entries
-    /// are in the input nonzeros.
+    /// multipliers, its groups' multipliers, the rank its groups' elimination may add to
+    /// the multipliers' diagonal block (`fill_rank_any`; `fill_rank_zero` when every
+    /// multiplier's diagonal is zero, so that a square group adds none), the border's
+    /// multipliers, and where the multipliers' diagonal entries are in the input nonzeros.
     first_dual: usize,
     kkt_shaped: bool,
     block_duals: Vec<usize>,
     group_duals: Vec<usize>,
-    group_fill_rank: Vec<usize>,
+    fill_rank_any: Vec<usize>,
+    fill_rank_zero: Vec<usize>,
     border_duals: usize,
     dual_diag: Vec<usize>,
     /// Scratch for `M`'s inertia: a copy of it and its pivots.
@@ -655,7 +657,8 @@ impl Workspace {
         ws.first_dual = usize::MAX;
         ws.block_duals = vec![0; count];
         ws.group_duals = vec![0; count];
-        ws.group_fill_rank = vec![0; count];
+        ws.fill_rank_any = vec![0; count];
+        ws.fill_rank_zero = vec![0; count];
         ws.m_copy = vec![0.0; max_l * max_l];
         ws.m_piv = vec![0; max_l];
         ws.rows = ia.iter().map(|&r| (r - 1) as u32).collect();
@@ -777,15 +780,24 @@ impl Workspace {
                 .iter()
                 .filter(|i| dual(i))
                 .count();
-            self.group_duals[b] = self.groups[blk.g_first..blk.g_first + blk.g_count]
-                .iter()
-                .map(|g| {
-                    self.g_members[g.first..g.first + g.q]
-                        .iter()
-                        .filter(|i| dual(i))
-                        .count()
-                })
-                .sum();
+            let (mut duals, mut any, mut zero) = (0, 0, 0);
+            for g in &self.groups[blk.g_first..blk.g_first + blk.g_count] {
+                let d = self.g_members[g.first..g.first + g.q]
+                    .iter()
+                    .filter(|i| dual(i))
+                    .count();
+                // Its elimination adds to the multipliers' diagonal block `B_Λᵀ (G⁻¹)_uu
+                // B_Λ`: of rank at most its primal count, and none when its multiplier
+                // block is zero and as large as its primal one (then `(G⁻¹)_uu = 0`).
+                duals += d;
+                any += g.q - d;
+                if 2 * d != g.q {
+                    zero += g.q - d;
+                }
+            }
+            self.group_duals[b] = duals;
+            self.fill_rank_any[b] = any;
+            self.fill_rank_zero[b] = zero;
         }
         self.border_duals = self.border.iter().filter(|i| dual(i)).count();
         self.dual_diag.clear();
@@ -812,13 +824,13 @@ impl Workspace {
     /// pos(K_P) + pos(S_ΛΛ) + |R| − |Λ|` (`S` the Schur complement on `R`), and `S_ΛΛ` is
     /// the multipliers' own diagonal (`−δ_c ≤ 0`, checked) minus what `P` adds to it: the
     /// next block's groups (nothing when a group's multiplier part is zero and square,
-    /// else at most its primal count: `group_fill_rank`) and the chain, `−C M Cᵀ`, with at
+    /// else at most its primal count: `fill_rank_zero` / `fill_rank_any`) and the chain, `−C M Cᵀ`, with at
     /// most `neg(M)` positive eigenvalues. With no zero pivot `pos(K_P) = |P| − negative`,
     /// so `pos(K) < n = dim − m` (the inertia pounce expects) as soon as
     /// `negative > m_P + m_border + group_fill_rank + neg(M)`: then the count cannot come
     /// out right, whatever the rest of the factorisation finds.
     ///
-    /// `base` is `m_P + m_border + group_fill_rank`; `m_copy`, `m_piv` and `work` are
+    /// `base` is `m_P + m_border +` the next block's fill rank; `m_copy`, `m_piv` and `work` are
     /// scratch.
     fn surplus(
         negative: usize,
@@ -888,28 +900,9 @@ impl Workspace {
     fn eliminate_groups(&mut self, b: usize, floor: f64) -> Option<usize> {
         let blk = self.blocks[b];
         let mut negative = 0;
-        let mut fill_rank = 0;
         for gi in blk.g_first..blk.g_first + blk.g_count {
             let g = self.groups[gi];
             let (q, nn) = (g.q, g.nn);
-            if self.first_dual != usize::MAX {
-                // The rank its elimination may add to the multipliers' diagonal block:
-                // none when its multiplier part is zero and as large as its primal part
-                // (then G⁻¹'s primal block is zero), else at most its primal count.
-                let members = &self.g_members[g.first..g.first + q];
-                let duals = members.iter().filter(|&&i| i >= self.first_dual).count();
-                let gm = &self.dense[g.g_off..g.g_off + q * q];
-                let zero = (0..q).all(|j| {
-                    (j..q).all(|i| {
-                        members[i] < self.first_dual
-                            || members[j] < self.first_dual
-                            || gm[i + j * q] == 0.0
-                    })
-                });
-                if !(zero && 2 * duals == q) {
-                    fill_rank += q - duals;
-                }
-            }
             let bm = &mut self.g_b[..q * nn];
             bm.copy_from_slice(&self.dense[g.g_off + q * q..g.g_off + q * q + q * nn]);
             let gm = &mut self.dense[g.g_off..g.g_off + q * q];
@@ -956,22 +949,13 @@ impl Workspace {
                 }
                 nz[n_nz] = j;
                 n_nz += 1;
-                if q == 2 {
-                    // The 2-D groups, unrolled: the same sums in the same order (a float
-                    // sum starts from -0.0, which adds nothing).
-                    yj[0] = inv[0] * bj[0] + inv[2] * bj[1];
-                    yj[1] = inv[1] * bj[0] + inv[3] * bj[1];
-                } else if q == 4 {
-                    // The 3-D groups, likewise.
-                    for (r, yr) in yj.iter_mut().enumerate() {
-                        *yr = inv[r] * bj[0]
-                            + inv[r + 4] * bj[1]
-                            + inv[r + 8] * bj[2]
-                            + inv[r + 12] * bj[3];
-                    }
-                } else {
-                    for (r, yr) in yj.iter_mut().enumerate() {
-                        *yr = (0..q).map(|c| inv[r + c * q] * bj[c]).sum();
+                match q {
+                    2 => group_multipliers::<2>(inv, bj, yj),
+                    4 => group_multipliers::<4>(inv, bj, yj),
+                    _ => {
+                        for (r, yr) in yj.iter_mut().enumerate() {
+                            *yr = (0..q).map(|c| inv[r + c * q] * bj[c]).sum();
+                        }
                     }
                 }
                 for &yr in yj.iter() {
@@ -993,40 +977,22 @@ impl Workspace {
                 // Column j of the lower triangle starts at Σ_{c<j} (nn - c).
                 let col = j * nn - j * j.saturating_sub(1) / 2;
                 let fill = &fill[col - j..];
-                if q == 2 {
-                    let (y0, y1) = (yj[0], yj[1]);
-                    let (bm, fill) = (&bm[..2 * nn], &fill[..nn]);
-                    for &i in &nz[jj..] {
-                        // SAFETY: i < nn (a neighbour's position), so 2i + 1 < bm.len()
-                        // and i < fill.len(); every fill destination is inside `dense`
-                        // (checked in `new`).
-                        unsafe {
-                            let v = bm.get_unchecked(2 * i) * y0 + bm.get_unchecked(2 * i + 1) * y1;
-                            *self.dense.get_unchecked_mut(*fill.get_unchecked(i)) -= v;
+                let (fill, later) = (&fill[..nn], &nz[jj..]);
+                // SAFETY (both unrolled cases): `nz` holds neighbour positions, below `nn`
+                // (it is filled from the `nn` columns of `B` above).
+                match q {
+                    2 => unsafe { subtract_fill::<2>(&mut self.dense, fill, bm, yj, later) },
+                    4 => unsafe { subtract_fill::<4>(&mut self.dense, fill, bm, yj, later) },
+                    _ => {
+                        for &i in later {
+                            let bi = &bm[i * q..(i + 1) * q];
+                            let v: f64 = bi.iter().zip(yj).map(|(a, b)| a * b).sum();
+                            self.dense[fill[i]] -= v;
                         }
-                    }
-                } else if q == 4 {
-                    let (y0, y1, y2, y3) = (yj[0], yj[1], yj[2], yj[3]);
-                    let (bm, fill) = (&bm[..4 * nn], &fill[..nn]);
-                    for &i in &nz[jj..] {
-                        let bi = &bm[4 * i..4 * i + 4];
-                        let v = bi[0] * y0 + bi[1] * y1 + bi[2] * y2 + bi[3] * y3;
-                        // SAFETY: i < nn = fill.len(); every fill destination is inside
-                        // `dense` (checked in `new`).
-                        unsafe {
-                            *self.dense.get_unchecked_mut(*fill.get_unchecked(i)) -= v;
-                        }
-                    }
-                } else {
-                    for &i in &nz[jj..] {
-                        let bi = &bm[i * q..(i + 1) * q];
-                        let v: f64 = bi.iter().zip(yj).map(|(a, b)| a * b).sum();
-                        self.dense[fill[i]] -= v;
                     }
                 }
             }
         }
-        self.group_fill_rank[b] = fill_rank;
         Some(negative)
     }
 
@@ -1040,11 +1006,24 @@ impl Workspace {
         self.assemble(count, values)?;
         let nb = self.border.len();
         let mut negative = 0;
-        // The test holds for a KKT's shape, with the multipliers' diagonal `−δ_c ≤ 0`.
-        let test = test
-            && self.first_dual != usize::MAX
-            && self.kkt_shaped
-            && self.dual_diag.iter().all(|&e| values[e] <= 0.0);
+        // The test holds for a KKT's shape, with the multipliers' diagonal `−δ_c ≤ 0`; the
+        // groups' fill rank depends on whether that diagonal is zero.
+        let (mut test, mut zero_diag) = (
+            test && self.first_dual != usize::MAX && self.kkt_shaped,
+            true,
+        );
+        if test {
+            for &e in &self.dual_diag {
+                test &= values[e] <= 0.0;
+                zero_diag &= values[e] == 0.0;
+            }
+        }
+        // The fill rank block `b`'s groups may add to the multipliers' diagonal block.
+        let fill_rank = |ws: &Workspace, b: usize| match ws.blocks.get(b) {
+            None => 0,
+            Some(_) if zero_diag => ws.fill_rank_zero[b],
+            Some(_) => ws.fill_rank_any[b],
+        };
         // Multipliers eliminated so far.
         let mut m_p = 0;
         if count > 0 {
@@ -1060,6 +1039,7 @@ impl Workspace {
                 negative += self.eliminate_groups(k + 1, floor)?;
                 m_p += self.group_duals[k + 1];
             }
+            let next_fill = fill_rank(self, k + 1);
             let (a_all, rest) = self.dense.split_at_mut(self.c_base);
             let (c_all, rest) = rest.split_at_mut(self.w_base - self.c_base);
             let (w_all, s) = rest.split_at_mut(self.s_off - self.w_base);
@@ -1096,8 +1076,7 @@ impl Workspace {
             let l = next.l;
             m_p += self.block_duals[k];
             if l == 0 {
-                let base =
-                    m_p + self.border_duals + self.group_fill_rank.get(k + 1).map_or(0, |&f| f);
+                let base = m_p + self.border_duals + next_fill;
                 if test && negative > base {
                     return Some(Count::Surplus);
                 }
@@ -1118,7 +1097,7 @@ impl Workspace {
                     mm[i + j * l] = bunch_kaufman::dot(gi, vj);
                 }
             }
-            let base = m_p + self.border_duals + self.group_fill_rank[k + 1];
+            let base = m_p + self.border_duals + next_fill;
             if test
                 && Self::surplus(
                     negative,
@@ -1359,6 +1338,49 @@ impl Workspace {
         }
         for (&w, &i) in self.work_b.iter().zip(&self.border) {
             b[i] = w;
+        }
+    }
+}
+
+/// `y = G⁻¹ b` for one neighbour of a pivot group of `Q` indices (`G⁻¹` column-major in
+/// `inv`), each entry summed left to right from its first product: the bits of a float
+/// `sum` over the same products (which starts from −0.0, adding nothing), unrolled.
+#[inline(always)]
+fn group_multipliers<const Q: usize>(inv: &[f64], b: &[f64], y: &mut [f64]) {
+    let (inv, b) = (&inv[..Q * Q], <&[f64; Q]>::try_from(&b[..Q]).expect("Q"));
+    for (r, yr) in y[..Q].iter_mut().enumerate() {
+        *yr = (1..Q).fold(inv[r] * b[0], |s, c| s + inv[r + c * Q] * b[c]);
+    }
+}
+
+/// A pivot group's fill in column `y` (its `Y` for one neighbour): for each later nonzero
+/// neighbour `i` in `rows`, `dense[fill[i]] -= B_iᵀ y`, the `Q`-term product summed as
+/// [`group_multipliers`] sums. `b` holds `B` (`Q` entries per neighbour).
+///
+/// # Safety
+/// Every entry of `rows` is below `fill.len()`, and every entry of `fill` below
+/// `dense.len()` (`Workspace::new` checks the fill destinations).
+#[inline(always)]
+unsafe fn subtract_fill<const Q: usize>(
+    dense: &mut [f64],
+    fill: &[usize],
+    b: &[f64],
+    y: &[f64],
+    rows: &[usize],
+) {
+    let y: &[f64; Q] = y[..Q].try_into().expect("Q");
+    assert!(b.len() >= Q * fill.len(), "Q entries of B per neighbour");
+    for &i in rows {
+        // SAFETY: i < fill.len() (the caller's promise), so Q·i + Q <= b.len();
+        // fill[i] < dense.len() (likewise).
+        unsafe {
+            let bi = &*(b.as_ptr().add(Q * i) as *const [f64; Q]);
+            let v = bi
+                .iter()
+                .zip(y)
+                .skip(1)
+                .fold(bi[0] * y[0], |s, (a, c)| s + a * c);
+            *dense.get_unchecked_mut(*fill.get_unchecked(i)) -= v;
         }
     }
 }
