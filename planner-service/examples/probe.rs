@@ -6,7 +6,7 @@
 //!
 //! Overrides: `PROBE_SW_ITERS`, `PROBE_SW_STALL`, `PROBE_SW_PARTICLES`, `PROBE_SW_THREADS` (the swarm's), `PROBE_STARTS`, `PROBE_FINALISTS`, `PROBE_ROUNDS`, `PROBE_RANK_PTS`,
 //! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`, `PROBE_DEFECT_TOL`
-//! (the refinement's tolerance, m), `PROBE_DUP_TOL` and `PROBE_GAP_TOL` (the finalists'
+//! (the refinement's tolerance, m), `PROBE_MAX_SPLIT` (its most parts per interval), `PROBE_DUP_TOL` and `PROBE_GAP_TOL` (the finalists'
 //! duplicate and gap tolerances),
 //! `PROBE_NLP="name=value;name=value"` (extra solver options; `PROBE_RANK_NLP` and
 //! `PROBE_FINAL_NLP` for the ranking or the working-mesh solves only, `PROBE_FIN_NLP` for the
@@ -15,7 +15,8 @@
 //! `PROBE_KKT=feral|structured` (the KKT linear solver of every NLP solve);
 //! `PROBE_SOC=0|1` and `PROBE_TOL` (the second-order check and the tolerance of the
 //! refined solves);
-//! `PROBE_ITS=1` prints every plan's NLP iterations per solve (deterministic, unlike times);
+//! `PROBE_ITS=1` prints every plan's NLP iterations per solve (deterministic, unlike times),
+//! and with `PROBE_MESH=1` its final mesh's intervals per phase;
 //! `PROBE_OUT=DIR` writes
 //! each plan's `plan.json` / `plan.csv` into `DIR/NAME-SEED/` for the judge.
 
@@ -98,6 +99,9 @@ fn main() {
     }
     if let Some(v) = env("PROBE_DEFECT_TOL") {
         s.refine.defect_tol_m = v;
+    }
+    if let Some(v) = env::<usize>("PROBE_MAX_SPLIT") {
+        s.refine.max_split = v;
     }
     if let Some(v) = env("PROBE_THREADS") {
         s.threads = v;
@@ -222,6 +226,9 @@ fn main() {
             if std::env::var("PROBE_ITS").is_ok() {
                 // One line per plan: `ITS name seed ratio [iterations per solve]`.
                 println!("ITS {name} {seed} {ratio:.5} {:?}", out.nlp.iterations);
+                if std::env::var("PROBE_MESH").is_ok() {
+                    println!("MESH {name} {seed} {:?}", out.nlp.intervals);
+                }
                 if std::env::var("PROBE_RANKED").is_ok() {
                     let best = out
                         .nlp
@@ -273,10 +280,12 @@ fn main() {
     println!("worst cost/ref {worst:.5}");
     println!(
         "KKT factorisations: {} by block elimination ({} without pivot groups, {} stopped on a \
-         surplus of negative eigenvalues), {} handed to FERAL",
+         surplus of negative eigenvalues), {} handed to FERAL; {} solves took their \
+         workspace from the pool",
         wingman_planner::collocation::kkt::block_factorizations_total(),
         wingman_planner::collocation::kkt::plain_factorizations_total(),
         wingman_planner::collocation::kkt::surplus_stops_total(),
-        wingman_planner::collocation::kkt::feral_fallbacks_total()
+        wingman_planner::collocation::kkt::feral_fallbacks_total(),
+        wingman_planner::collocation::kkt::workspace_reuses_total()
     );
 }

@@ -55,6 +55,9 @@ use pounce_rs::{Index, Number};
 use super::bunch_kaufman;
 use super::transcription::Transcription;
 
+mod pool;
+pub use pool::workspace_reuses_total;
+
 /// Which linear solver factors the KKT systems of the NLP solves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum KktSolver {
@@ -397,6 +400,48 @@ fn clear_lower(a: &mut [f64], n: usize) {
 const GROUP_GROWTH_MAX: f64 = 1e6;
 
 impl Workspace {
+    /// About the bytes its buffers hold (the pool's budget).
+    fn bytes(&self) -> usize {
+        let f64s = [
+            &self.dense,
+            &self.y,
+            &self.z,
+            &self.g_w,
+            &self.g_l,
+            &self.bk_work,
+            &self.m_link,
+            &self.y_link,
+            &self.cm,
+            &self.work,
+            &self.work_b,
+            &self.ctx,
+            &self.rhs,
+            &self.res,
+            &self.g_y,
+            &self.g_b,
+            &self.g_work,
+            &self.g_inv,
+            &self.m_copy,
+        ]
+        .iter()
+        .map(|v| v.capacity())
+        .sum::<usize>();
+        let words = [
+            &self.dest,
+            &self.owner_start,
+            &self.members,
+            &self.g_fill,
+            &self.g_members,
+            &self.g_nbrs,
+            &self.g_nz,
+        ]
+        .iter()
+        .map(|v| v.capacity())
+        .sum::<usize>();
+        let halves = self.by_owner.capacity() + self.rows.capacity() + self.cols.capacity();
+        8 * (f64s + words) + 4 * halves
+    }
+
     /// The workspace for the pattern `(ia, ja)` (1-based) under the block `labels` and
     /// the pivot `groups` (empty: none), or `None` when they do not describe it (an entry
     /// coupling two blocks that are not neighbours in label order, or two groups; a group
@@ -1438,6 +1483,10 @@ pub struct StructuredKkt {
     pub feral_factorizations: usize,
     /// Of `block_factorizations`, those stopped on a surplus of negative eigenvalues.
     pub surplus_stops: usize,
+    /// The pattern `ws` was built for (returned to the pool with it).
+    pattern: Option<(Vec<Index>, Vec<Index>)>,
+    /// Whether `ws` came from the pool (for tests and diagnostics).
+    pub reused: bool,
 }
 
 impl StructuredKkt {
@@ -1459,6 +1508,25 @@ impl StructuredKkt {
             block_factorizations: 0,
             feral_factorizations: 0,
             surplus_stops: 0,
+            pattern: None,
+            reused: false,
+        }
+    }
+
+    /// Returns the workspaces to the pool, for the next solve with the same pattern.
+    fn release(&mut self) {
+        let ws = self.ws.take();
+        let plain = self.plain.take();
+        let pattern = self.pattern.take();
+        if let (Some(ws), Some((ia, ja)), Some(labels)) = (ws, pattern, self.labels.as_ref()) {
+            pool::give_back(pool::Pooled {
+                dim: self.dim,
+                ia,
+                ja,
+                labels: labels.clone(),
+                ws,
+                plain,
+            });
         }
     }
 
@@ -1491,6 +1559,12 @@ impl StructuredKkt {
     }
 }
 
+impl Drop for StructuredKkt {
+    fn drop(&mut self) {
+        self.release();
+    }
+}
+
 impl SparseSymLinearSolverInterface for StructuredKkt {
     fn initialize_structure(
         &mut self,
@@ -1500,17 +1574,29 @@ impl SparseSymLinearSolverInterface for StructuredKkt {
         ja: &[Index],
     ) -> ESymSolverStatus {
         let status = self.feral.initialize_structure(dim, nonzeros, ia, ja);
+        self.release();
         self.dim = dim.max(0) as usize;
         self.values = vec![0.0; nonzeros.max(0) as usize];
         self.floor = self.dim as f64 * f64::EPSILON;
         self.factored = Factored::None;
         self.switched = false;
-        self.plain = None;
         self.on_plain = false;
-        self.ws = self
-            .labels
-            .as_ref()
-            .and_then(|l| Workspace::new(self.dim, ia, ja, &l.blocks, &l.groups));
+        self.reused = false;
+        if let Some(l) = self.labels.as_ref() {
+            // A workspace is a function of the pattern and the labels alone: one built
+            // for this very pattern factors as a new one would (see `pool`).
+            if let Some(p) = pool::take(self.dim, ia, ja, l) {
+                self.ws = Some(p.ws);
+                self.plain = p.plain;
+                self.pattern = Some((p.ia, p.ja));
+                self.reused = true;
+            } else {
+                self.ws = Workspace::new(self.dim, ia, ja, &l.blocks, &l.groups);
+                if self.ws.is_some() {
+                    self.pattern = Some((ia.to_vec(), ja.to_vec()));
+                }
+            }
+        }
         if self.ws.is_none() && self.labels.is_some() {
             tracing::debug!(
                 dim,
@@ -1632,6 +1718,7 @@ impl SparseSymLinearSolverInterface for StructuredKkt {
         }
         self.plain = None;
         self.on_plain = false;
+        self.pattern = None;
         if self.ws.take().is_some() {
             tracing::debug!(dim = self.dim, "KKT quality raised; FERAL takes over");
             self.switched = true;
@@ -1968,6 +2055,65 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A solve takes the workspace a finished solve of the same pattern left in the pool,
+    /// and computes the same bits as a solve on a workspace built for it; a solve of
+    /// another pattern (one nonzero fewer) does not take it.
+    #[test]
+    fn a_pooled_workspace_solves_as_a_new_one() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4242);
+        // Block sizes no other test draws, so that no other test's workspace fits.
+        let mut a = arrowhead(&[13, 7, 16, 5, 11], 4, true, &mut rng);
+        let groups = add_groups(&mut a, 2, 1e-2, &mut rng);
+        let dim = a.k.nrows();
+        let labels = KktLabels {
+            blocks: a.labels.clone(),
+            groups,
+        };
+        let values: Vec<f64> =
+            a.va.iter()
+                .map(|v| v * rng.random_range(-1.5..1.5))
+                .collect();
+        let b: Vec<f64> = (0..dim).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let mut first = StructuredKkt::new(Some(labels.clone()), feral_cfg());
+        let mut x = b.clone();
+        let _ = solve_with(&mut first, &a.ia, &a.ja, &a.va, &mut x, 1, None);
+        assert!(first.is_structured() && !first.reused);
+        drop(first);
+        let mut pooled = StructuredKkt::new(Some(labels.clone()), feral_cfg());
+        let mut x_pooled = b.clone();
+        let status = solve_with(&mut pooled, &a.ia, &a.ja, &values, &mut x_pooled, 1, None);
+        assert!(
+            pooled.reused,
+            "the finished solve's workspace was not taken"
+        );
+        // The pooled one is in use: this one is built.
+        let mut built = StructuredKkt::new(Some(labels.clone()), feral_cfg());
+        let mut x_built = b.clone();
+        let status_built = solve_with(&mut built, &a.ia, &a.ja, &values, &mut x_built, 1, None);
+        assert!(!built.reused);
+        assert_eq!(status, status_built);
+        assert_eq!(pooled.block_factorizations, 1);
+        assert_eq!(pooled.number_of_neg_evals(), built.number_of_neg_evals());
+        let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&x_pooled), bits(&x_built), "pooled and built differ");
+        drop(pooled);
+        drop(built);
+        // Another pattern: the last entry dropped.
+        let n = a.ia.len() - 1;
+        let mut other = StructuredKkt::new(Some(labels), feral_cfg());
+        let mut x_other = b.clone();
+        let _ = solve_with(
+            &mut other,
+            &a.ia[..n],
+            &a.ja[..n],
+            &values[..n],
+            &mut x_other,
+            1,
+            None,
+        );
+        assert!(!other.reused, "a workspace of another pattern was taken");
     }
 
     /// Two groups coupled to each other do not fit: FERAL factors that matrix.

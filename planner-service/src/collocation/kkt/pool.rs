@@ -1,0 +1,81 @@
+//! Workspaces of recently factorised KKT patterns, kept for the next solve with the same
+//! pattern.
+//!
+//! Building a [`Workspace`] (placing every nonzero, finding the pivot groups, their fill
+//! and the surplus test's ranks) costs about as much as three factorisations of a 2-D
+//! plan's KKT, and every NLP solve builds one. The patterns repeat: a re-plan of the
+//! same mission solves on meshes of the same shapes (on the 2-D canonical scenarios, the
+//! fifth plan of a scenario met only patterns the first four had). A workspace is a pure
+//! function of its pattern and labels, and every factorisation overwrites what it reads
+//! (`a_reused_workspace_factors_as_a_fresh_one`), so a solve that takes one from here
+//! computes the same bits as with a new one.
+//!
+//! The pool is process-wide (the planner's solver threads are created per plan) and
+//! bounded by [`POOL_BYTES`]: the least recently returned workspace goes first.
+
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use pounce_rs::Index;
+
+use super::{KktLabels, Workspace};
+
+/// Most bytes of buffers the pool keeps (a refined 3-D mesh's workspace holds ~6 MB).
+pub(super) const POOL_BYTES: usize = 48 << 20;
+
+/// A workspace with the pattern it was built for.
+pub(super) struct Pooled {
+    pub dim: usize,
+    pub ia: Vec<Index>,
+    pub ja: Vec<Index>,
+    pub labels: KktLabels,
+    pub ws: Workspace,
+    /// The same blocks without the pivot groups, if that solve needed it.
+    pub plain: Option<Workspace>,
+}
+
+impl Pooled {
+    fn bytes(&self) -> usize {
+        let plain = self.plain.as_ref().map_or(0, Workspace::bytes);
+        self.ws.bytes() + plain + 4 * (self.ia.capacity() + self.ja.capacity())
+    }
+
+    fn fits(&self, dim: usize, ia: &[Index], ja: &[Index], labels: &KktLabels) -> bool {
+        self.dim == dim && self.ia == ia && self.ja == ja && self.labels == *labels
+    }
+}
+
+/// Least recently returned first.
+static POOL: Mutex<Vec<Pooled>> = Mutex::new(Vec::new());
+
+/// Workspaces taken from the pool instead of built, over the process.
+static REUSES: AtomicUsize = AtomicUsize::new(0);
+
+/// How many solves in this process took their KKT workspace from the pool.
+pub fn workspace_reuses_total() -> usize {
+    REUSES.load(Ordering::Relaxed)
+}
+
+fn pool() -> std::sync::MutexGuard<'static, Vec<Pooled>> {
+    // Nothing panics under the lock; recover anyway (the pool is only a cache).
+    POOL.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// The pooled workspace built for exactly this pattern and these labels, if any.
+pub(super) fn take(dim: usize, ia: &[Index], ja: &[Index], labels: &KktLabels) -> Option<Pooled> {
+    let mut pool = pool();
+    let i = pool.iter().rposition(|p| p.fits(dim, ia, ja, labels))?;
+    REUSES.fetch_add(1, Ordering::Relaxed);
+    Some(pool.remove(i))
+}
+
+/// Keeps `p` for a later solve, dropping the least recently returned workspaces beyond
+/// [`POOL_BYTES`].
+pub(super) fn give_back(p: Pooled) {
+    let mut pool = pool();
+    pool.push(p);
+    let mut total: usize = pool.iter().map(Pooled::bytes).sum();
+    while total > POOL_BYTES && !pool.is_empty() {
+        total -= pool.remove(0).bytes();
+    }
+}
