@@ -2,14 +2,16 @@
 //! swarm seeds — median and p95 of the plan time, the share of swarm, NLP and the rest,
 //! the cost spread across seeds, peak heap — and how far past a too-short deadline the
 //! planner returns. Prints a Markdown table (run with `cargo bench -p wingman-planner
-//! --bench plan`; `-- --runs N`, `-- --only NAME` to narrow it).
+//! --bench plan`; `-- --runs N`, `-- --only NAME` to narrow it, `-- --sequential`).
 //!
 //! The peak heap is counted in a pass of its own (the same plans again), not in the
 //! timed runs: the counting allocator's shared counters, updated by both threads at
 //! every allocation of the solver, cost the timed plans up to 15 %.
 //!
-//! The last column times a fixed workload (`host_reference_ms`) just before and just after
-//! each scenario's timed plans: the host's speed while they ran.
+//! The scenarios are interleaved: round `k` plans every scenario with seed `k`, so that
+//! each scenario's runs spread over the whole bench (`-- --sequential`: each scenario's
+//! runs in a row). A fixed workload (`host_reference_ms`) is timed before every round and
+//! at the end: the host's speed while the plans ran.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicIsize, Ordering};
@@ -64,8 +66,8 @@ static GLOBAL: Peak = Peak;
 
 /// The host's speed now: a fixed workload (400 dense Bunch–Kaufman factorisations of one
 /// 72 × 72 KKT-shaped block, the planner's hottest kernel) run on two threads at once, as
-/// the planner runs; the slower thread's median of three timings, in ms. Timed before and
-/// after each scenario, so that its plan times can be read against the speed the host had
+/// the planner runs; the slower thread's median of three timings, in ms. Timed before
+/// every round of plans, so that their times can be read against the speed the host had
 /// while they ran (a shared VM's speed swings by up to 1.8× within minutes;
 /// docs/BENCHMARKS.md).
 fn host_reference_ms() -> f64 {
@@ -105,6 +107,18 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[k.min(sorted.len() - 1)]
 }
 
+/// One scenario's timed plans.
+#[derive(Default)]
+struct Tally {
+    times: Vec<f64>,
+    swarm: f64,
+    nlp: f64,
+    ranking: f64,
+    total: f64,
+    costs: Vec<f64>,
+    qualities: std::collections::BTreeMap<String, usize>,
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let runs: u64 = args
@@ -118,81 +132,120 @@ fn main() {
         .position(|a| a == "--only")
         .and_then(|i| args.get(i + 1))
         .cloned();
+    let sequential = args.iter().any(|a| a == "--sequential");
     let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
     let settings = PlannerSettings::default();
-    println!(
-        "| scenario | median ms | p95 ms | swarm % | NLP % | of it ranking % | rest % | cost min | cost max | spread % | peak heap MiB | quality | host ref ms |"
-    );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|");
-    for (name, _) in BUNDLED {
-        if only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
-            continue;
-        }
-        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
-        let mut times = Vec::new();
-        let (mut swarm, mut nlp, mut ranking, mut total) = (0.0, 0.0, 0.0, 0.0);
-        let mut costs = Vec::new();
-        let mut qualities = std::collections::BTreeMap::new();
-        let reference_before = host_reference_ms();
-        for seed in 1..=runs {
-            let s = PlannerSettings {
-                swarm: settings.swarm.clone().with_seed(seed),
-                ..settings.clone()
-            };
-            let mut planner = Planner::new(&s);
-            let out = planner
-                .plan(
-                    &problem,
-                    &s,
-                    Deadline::after(clock, Duration::from_secs(30)),
-                )
-                .unwrap();
-            let t = out.times.total.as_secs_f64() * 1e3;
-            times.push(t);
-            swarm += out.times.swarm.as_secs_f64() * 1e3;
-            nlp += out.times.nlp.as_secs_f64() * 1e3;
-            ranking += out.times.ranking.as_secs_f64() * 1e3;
-            total += t;
-            costs.push(out.cost);
-            *qualities.entry(format!("{:?}", out.quality)).or_insert(0) += 1;
-        }
-        let reference_after = host_reference_ms();
-        // The peak heap over the same plans, untimed.
-        let peak = peak_of(|| {
+    let scenarios: Vec<(&str, Problem)> = BUNDLED
+        .iter()
+        .filter(|(name, _)| only.as_ref().is_none_or(|o| name.contains(o.as_str())))
+        .map(|(name, _)| {
+            let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+            (*name, problem)
+        })
+        .collect();
+    let settings_of = |seed: u64| PlannerSettings {
+        swarm: settings.swarm.clone().with_seed(seed),
+        ..settings.clone()
+    };
+    let plan = |problem: &Problem, seed: u64, tally: &mut Tally| {
+        let s = settings_of(seed);
+        let mut planner = Planner::new(&s);
+        let out = planner
+            .plan(problem, &s, Deadline::after(clock, Duration::from_secs(30)))
+            .unwrap();
+        let t = out.times.total.as_secs_f64() * 1e3;
+        tally.times.push(t);
+        tally.swarm += out.times.swarm.as_secs_f64() * 1e3;
+        tally.nlp += out.times.nlp.as_secs_f64() * 1e3;
+        tally.ranking += out.times.ranking.as_secs_f64() * 1e3;
+        tally.total += t;
+        tally.costs.push(out.cost);
+        *tally
+            .qualities
+            .entry(format!("{:?}", out.quality))
+            .or_insert(0) += 1;
+    };
+    // Interleaved (default): round `seed` plans every scenario once, so that each
+    // scenario's runs spread over the whole bench and a slow spell of the host weighs on
+    // all scenarios alike instead of on whichever ran through it. `--sequential`: each
+    // scenario's runs in a row (a stream of re-plans of one mission).
+    let mut tallies: Vec<Tally> = scenarios.iter().map(|_| Tally::default()).collect();
+    let mut host = Vec::new();
+    if sequential {
+        for ((_, problem), tally) in scenarios.iter().zip(&mut tallies) {
+            host.push(host_reference_ms());
             for seed in 1..=runs {
-                let s = PlannerSettings {
-                    swarm: settings.swarm.clone().with_seed(seed),
-                    ..settings.clone()
-                };
-                let mut planner = Planner::new(&s);
-                let plan = planner.plan(
-                    &problem,
-                    &s,
-                    Deadline::after(clock, Duration::from_secs(30)),
-                );
-                assert!(plan.is_ok());
+                plan(problem, seed, tally);
             }
-        }) as f64
-            / (1024.0 * 1024.0);
-        times.sort_by(f64::total_cmp);
-        costs.sort_by(f64::total_cmp);
+        }
+    } else {
+        for seed in 1..=runs {
+            host.push(host_reference_ms());
+            for ((_, problem), tally) in scenarios.iter().zip(&mut tallies) {
+                plan(problem, seed, tally);
+            }
+        }
+    }
+    host.push(host_reference_ms());
+    // The peak heap of each scenario's plans, untimed, from an empty workspace pool (the
+    // pool keeps the workspaces it is given back, up to its budget: counted here).
+    let peaks: Vec<f64> = scenarios
+        .iter()
+        .map(|(_, problem)| {
+            wingman_planner::collocation::kkt::clear_workspace_pool();
+            peak_of(|| {
+                for seed in 1..=runs {
+                    let s = settings_of(seed);
+                    let mut planner = Planner::new(&s);
+                    let plan =
+                        planner.plan(problem, &s, Deadline::after(clock, Duration::from_secs(30)));
+                    assert!(plan.is_ok());
+                }
+            }) as f64
+                / (1024.0 * 1024.0)
+        })
+        .collect();
+    println!(
+        "| scenario | median ms | p95 ms | swarm % | NLP % | of it ranking % | rest % | cost min | cost max | spread % | peak heap MiB | quality |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    for (((name, _), tally), peak) in scenarios.iter().zip(&mut tallies).zip(&peaks) {
+        tally.times.sort_by(f64::total_cmp);
+        tally.costs.sort_by(f64::total_cmp);
+        let (times, costs, total) = (&tally.times, &tally.costs, tally.total);
         let (lo, hi) = (costs[0], costs[costs.len() - 1]);
         println!(
-            "| {name} | {:.1} | {:.1} | {:.0} | {:.0} | {:.0} | {:.0} | {lo:.6} | {hi:.6} | {:.3} | {peak:.1} | {} | {reference_before:.1} / {reference_after:.1} |",
-            percentile(&times, 0.5),
-            percentile(&times, 0.95),
-            100.0 * swarm / total,
-            100.0 * nlp / total,
-            100.0 * ranking / total,
-            100.0 * (total - swarm - nlp) / total,
+            "| {name} | {:.1} | {:.1} | {:.0} | {:.0} | {:.0} | {:.0} | {lo:.6} | {hi:.6} | {:.3} | {peak:.1} | {} |",
+            percentile(times, 0.5),
+            percentile(times, 0.95),
+            100.0 * tally.swarm / total,
+            100.0 * tally.nlp / total,
+            100.0 * tally.ranking / total,
+            100.0 * (total - tally.swarm - tally.nlp) / total,
             100.0 * (hi - lo) / lo.abs().max(1e-12),
-            qualities
+            tally
+                .qualities
                 .iter()
                 .map(|(q, n)| format!("{q} {n}"))
                 .collect::<Vec<_>>()
                 .join(", "),
         );
     }
+    let order = if sequential {
+        "before each scenario's runs and at the end"
+    } else {
+        "before each round of all scenarios and at the end"
+    };
+    let text: Vec<String> = host.iter().map(|h| format!("{h:.1}")).collect();
+    host.sort_by(f64::total_cmp);
+    println!(
+        "\nhost ref ms ({order}): {} (min {:.1}, median {:.1}, max {:.1}); {} solves took their KKT workspace from the pool",
+        text.join(" "),
+        host[0],
+        percentile(&host, 0.5),
+        host[host.len() - 1],
+        wingman_planner::collocation::kkt::workspace_reuses_total(),
+    );
     // Deadline overshoot: a budget far too short for the NLP.
     println!("\n| scenario | budget ms | returned after ms (median / max of {runs}) | quality |");
     println!("|---|---:|---:|---|");

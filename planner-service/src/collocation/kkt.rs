@@ -56,7 +56,7 @@ use super::bunch_kaufman;
 use super::transcription::Transcription;
 
 mod pool;
-pub use pool::workspace_reuses_total;
+pub use pool::{clear_workspace_pool, workspace_reuses_total};
 
 /// Which linear solver factors the KKT systems of the NLP solves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

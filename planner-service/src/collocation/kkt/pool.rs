@@ -56,6 +56,11 @@ pub fn workspace_reuses_total() -> usize {
     REUSES.load(Ordering::Relaxed)
 }
 
+/// Drops every pooled workspace (benchmarks count the heap from an empty pool).
+pub fn clear_workspace_pool() {
+    pool().clear();
+}
+
 fn pool() -> std::sync::MutexGuard<'static, Vec<Pooled>> {
     // Nothing panics under the lock; recover anyway (the pool is only a cache).
     POOL.lock().unwrap_or_else(|e| e.into_inner())
