@@ -159,13 +159,15 @@ pub fn seed_trajectory(problem: &Problem, seed: &Seed) -> Option<Trajectory> {
 }
 
 /// Up to `count` starts: `first` (the swarm's best), then the cheapest seeds whose
-/// signature differs from every start taken so far, ranked by `cost`.
+/// signature differs from every start taken so far, ranked by `cost`. The seeds' paths
+/// and costs are computed on `threads` threads (the same result for any number).
 pub fn candidates(
     problem: &Problem,
     first: &Trajectory,
     seeds: &[Seed],
     count: usize,
-    cost: impl Fn(&Trajectory) -> f64,
+    threads: usize,
+    cost: impl Fn(&Trajectory) -> f64 + Sync,
 ) -> Vec<Trajectory> {
     let three_d = problem.dim() == 3;
     let xy = |tr: &Trajectory| -> Vec<[f64; 3]> {
@@ -179,12 +181,8 @@ pub fn candidates(
     if count <= 1 {
         return out;
     }
-    let mut ranked: Vec<(f64, usize, Trajectory)> = seeds
-        .iter()
-        .enumerate()
-        .filter_map(|(i, s)| seed_trajectory(problem, s).map(|tr| (cost(&tr), i, tr)))
-        .filter(|(c, _, _)| c.is_finite())
-        .collect();
+    let mut ranked = ranked_seeds(problem, seeds, threads, &cost);
+    ranked.retain(|(c, _, _)| c.is_finite());
     ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let mut rest = Vec::new();
     for (_, _, tr) in ranked {
@@ -213,6 +211,38 @@ pub fn candidates(
     out
 }
 
+/// Every seed's path with its cost and index (seeds without a path left out), computed
+/// on up to `threads` threads: the seeds are dealt out in turn (their paths differ in
+/// length), each thread keeps its own, and the order is the caller's to set.
+fn ranked_seeds(
+    problem: &Problem,
+    seeds: &[Seed],
+    threads: usize,
+    cost: &(impl Fn(&Trajectory) -> f64 + Sync),
+) -> Vec<(f64, usize, Trajectory)> {
+    let path = |i: usize| seed_trajectory(problem, &seeds[i]).map(|tr| (cost(&tr), i, tr));
+    let threads = threads.clamp(1, seeds.len().max(1));
+    let share = |t: usize| (t..seeds.len()).step_by(threads).filter_map(path);
+    if threads == 1 {
+        return share(0).collect();
+    }
+    std::thread::scope(|scope| {
+        let others: Vec<_> = (1..threads)
+            .map(|t| scope.spawn(move || share(t).collect::<Vec<_>>()))
+            .collect();
+        let mut all: Vec<_> = share(0).collect();
+        for other in others {
+            // A panic there is a bug: raise it here.
+            all.extend(
+                other
+                    .join()
+                    .unwrap_or_else(|e| std::panic::resume_unwind(e)),
+            );
+        }
+        all
+    })
+}
+
 /// Mean horizontal distance that makes two paths of one class distinct starts (or two
 /// ranked solutions distinct finalists).
 pub const MIN_SEPARATION_M: f64 = 3000.0;
@@ -233,4 +263,31 @@ pub fn separation(a: &Trajectory, b: &Trajectory) -> f64 {
         })
         .sum::<f64>()
         / n as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::bundled;
+    use crate::seeding::{SeedSettings, seeds};
+
+    /// The starts, their order included, are the same bits on one, two and three threads
+    /// (the seeds' paths and costs are dealt out to the threads), in 2-D and 3-D.
+    #[test]
+    fn candidates_do_not_depend_on_the_threads() {
+        for name in ["2d-min-time-unavoidable", "3d-min-time-rendezvous-avoidable"] {
+            let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+            let mut all = Vec::new();
+            seeds(&problem, &SeedSettings::default(), &mut all).unwrap();
+            assert!(all.len() > 8, "{name}: {} seeds", all.len());
+            let first = seed_trajectory(&problem, &all[0]).expect("a path");
+            let cost = |tr: &Trajectory| crate::hybrid::trajectory_cost(&problem, tr);
+            let one = candidates(&problem, &first, &all, 5, 1, cost);
+            assert!(one.len() >= 3, "{name}: {} starts", one.len());
+            for threads in [2, 3] {
+                let more = candidates(&problem, &first, &all, 5, threads, cost);
+                assert_eq!(one, more, "{name}: {threads} threads differ from one");
+            }
+        }
+    }
 }

@@ -670,9 +670,15 @@ impl Planner {
             Vec::new()
         } else {
             let count = settings.starts.max(1);
-            basins::candidates(problem, &sw.best, self.swarm.seeds(), count, |tr| {
-                trajectory_cost(problem, tr)
-            })
+            let threads = settings.threads.max(1);
+            basins::candidates(
+                problem,
+                &sw.best,
+                self.swarm.seeds(),
+                count,
+                threads,
+                |tr| trajectory_cost(problem, tr),
+            )
         };
         // Rank every start on the coarse mesh, solve the best distinct ones on the working
         // mesh, refine the best of those: scheduled on the planner's threads (`schedule`).
