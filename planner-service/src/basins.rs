@@ -275,7 +275,10 @@ mod tests {
     /// (the seeds' paths and costs are dealt out to the threads), in 2-D and 3-D.
     #[test]
     fn candidates_do_not_depend_on_the_threads() {
-        for name in ["2d-min-time-unavoidable", "3d-min-time-rendezvous-avoidable"] {
+        for name in [
+            "2d-min-time-unavoidable",
+            "3d-min-time-rendezvous-avoidable",
+        ] {
             let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
             let mut all = Vec::new();
             seeds(&problem, &SeedSettings::default(), &mut all).unwrap();

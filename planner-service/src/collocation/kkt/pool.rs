@@ -20,8 +20,9 @@ use pounce_rs::Index;
 
 use super::{KktLabels, Workspace};
 
-/// Most bytes of buffers the pool keeps (a refined 3-D mesh's workspace holds ~6 MB).
-pub(super) const POOL_BYTES: usize = 48 << 20;
+/// Most bytes of buffers the pool keeps: about one 3-D plan's workspaces (25-30 MB over
+/// its solves), or four 2-D plans' (about 7 MB each).
+pub(super) const POOL_BYTES: usize = 32 << 20;
 
 /// A workspace with the pattern it was built for.
 pub(super) struct Pooled {
