@@ -4,8 +4,9 @@
 //! Building a [`Workspace`] (placing every nonzero, finding the pivot groups, their fill
 //! and the surplus test's ranks) costs about as much as three factorisations of a 2-D
 //! plan's KKT, and every NLP solve builds one. The patterns repeat: a re-plan of the
-//! same mission solves on meshes of the same shapes (on the 2-D canonical scenarios, the
-//! fifth plan of a scenario met only patterns the first four had). A workspace is a pure
+//! same mission solves on meshes of the same shapes (five plans of
+//! 2d-min-time-unavoidable, seeds 1-5, met 16 distinct patterns in 44 solves, the fifth
+//! plan only patterns the first four had). A workspace is a pure
 //! function of its pattern and labels, and every factorisation overwrites what it reads
 //! (`a_reused_workspace_factors_as_a_fresh_one`), so a solve that takes one from here
 //! computes the same bits as with a new one.
