@@ -670,13 +670,12 @@ impl Planner {
             Vec::new()
         } else {
             let count = settings.starts.max(1);
-            let threads = settings.threads.max(1);
             basins::candidates(
                 problem,
                 &sw.best,
                 self.swarm.seeds(),
                 count,
-                threads,
+                settings.threads,
                 |tr| trajectory_cost(problem, tr),
             )
         };

@@ -400,6 +400,19 @@ fn clear_lower(a: &mut [f64], n: usize) {
 const GROUP_GROWTH_MAX: f64 = 1e6;
 
 impl Workspace {
+    /// Whether it was built for the pattern `(ia, ja)` (1-based) of order `dim`: the
+    /// pattern it keeps for the refinement residual, compared entry by entry.
+    fn same_pattern(&self, dim: usize, ia: &[Index], ja: &[Index]) -> bool {
+        let same = |kept: &[u32], given: &[Index]| {
+            kept.len() == given.len()
+                && kept
+                    .iter()
+                    .zip(given)
+                    .all(|(&k, &g)| i64::from(k) + 1 == i64::from(g))
+        };
+        self.res.len() == dim && same(&self.rows, ia) && same(&self.cols, ja)
+    }
+
     /// About the bytes its buffers hold (the pool's budget).
     fn bytes(&self) -> usize {
         let f64s = [
@@ -1483,8 +1496,6 @@ pub struct StructuredKkt {
     pub feral_factorizations: usize,
     /// Of `block_factorizations`, those stopped on a surplus of negative eigenvalues.
     pub surplus_stops: usize,
-    /// The pattern `ws` was built for (returned to the pool with it).
-    pattern: Option<(Vec<Index>, Vec<Index>)>,
     /// Whether `ws` came from the pool (for tests and diagnostics).
     pub reused: bool,
 }
@@ -1508,25 +1519,15 @@ impl StructuredKkt {
             block_factorizations: 0,
             feral_factorizations: 0,
             surplus_stops: 0,
-            pattern: None,
             reused: false,
         }
     }
 
     /// Returns the workspaces to the pool, for the next solve with the same pattern.
     fn release(&mut self) {
-        let ws = self.ws.take();
         let plain = self.plain.take();
-        let pattern = self.pattern.take();
-        if let (Some(ws), Some((ia, ja)), Some(labels)) = (ws, pattern, self.labels.as_ref()) {
-            pool::give_back(pool::Pooled {
-                dim: self.dim,
-                ia,
-                ja,
-                labels: labels.clone(),
-                ws,
-                plain,
-            });
+        if let (Some(ws), Some(labels)) = (self.ws.take(), self.labels.as_ref()) {
+            pool::give_back(pool::Pooled::new(labels.clone(), ws, plain));
         }
     }
 
@@ -1588,13 +1589,9 @@ impl SparseSymLinearSolverInterface for StructuredKkt {
             if let Some(p) = pool::take(self.dim, ia, ja, l) {
                 self.ws = Some(p.ws);
                 self.plain = p.plain;
-                self.pattern = Some((p.ia, p.ja));
                 self.reused = true;
             } else {
                 self.ws = Workspace::new(self.dim, ia, ja, &l.blocks, &l.groups);
-                if self.ws.is_some() {
-                    self.pattern = Some((ia.to_vec(), ja.to_vec()));
-                }
             }
         }
         if self.ws.is_none() && self.labels.is_some() {
@@ -1718,7 +1715,6 @@ impl SparseSymLinearSolverInterface for StructuredKkt {
         }
         self.plain = None;
         self.on_plain = false;
-        self.pattern = None;
         if self.ws.take().is_some() {
             tracing::debug!(dim = self.dim, "KKT quality raised; FERAL takes over");
             self.switched = true;

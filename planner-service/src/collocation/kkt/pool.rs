@@ -25,25 +25,28 @@ use super::{KktLabels, Workspace};
 /// its solves), or four 2-D plans' (about 7 MB each).
 pub(super) const POOL_BYTES: usize = 32 << 20;
 
-/// A workspace with the pattern it was built for.
+/// A workspace with the labels it was built under (its pattern it keeps itself).
 pub(super) struct Pooled {
-    pub dim: usize,
-    pub ia: Vec<Index>,
-    pub ja: Vec<Index>,
     pub labels: KktLabels,
     pub ws: Workspace,
     /// The same blocks without the pivot groups, if that solve needed it.
     pub plain: Option<Workspace>,
+    bytes: usize,
 }
 
 impl Pooled {
-    fn bytes(&self) -> usize {
-        let plain = self.plain.as_ref().map_or(0, Workspace::bytes);
-        self.ws.bytes() + plain + 4 * (self.ia.capacity() + self.ja.capacity())
+    pub fn new(labels: KktLabels, ws: Workspace, plain: Option<Workspace>) -> Pooled {
+        let bytes = ws.bytes() + plain.as_ref().map_or(0, Workspace::bytes);
+        Pooled {
+            labels,
+            ws,
+            plain,
+            bytes,
+        }
     }
 
     fn fits(&self, dim: usize, ia: &[Index], ja: &[Index], labels: &KktLabels) -> bool {
-        self.dim == dim && self.ia == ia && self.ja == ja && self.labels == *labels
+        self.labels == *labels && self.ws.same_pattern(dim, ia, ja)
     }
 }
 
@@ -81,8 +84,8 @@ pub(super) fn take(dim: usize, ia: &[Index], ja: &[Index], labels: &KktLabels) -
 pub(super) fn give_back(p: Pooled) {
     let mut pool = pool();
     pool.push(p);
-    let mut total: usize = pool.iter().map(Pooled::bytes).sum();
+    let mut total: usize = pool.iter().map(|p| p.bytes).sum();
     while total > POOL_BYTES && !pool.is_empty() {
-        total -= pool.remove(0).bytes();
+        total -= pool.remove(0).bytes;
     }
 }
