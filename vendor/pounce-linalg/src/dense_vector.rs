@@ -79,7 +79,7 @@ impl DenseVectorSpace {
 /// materialise (the solver makes and drops tens of thousands of same-sized vectors per
 /// solve; each took a trip through the system allocator). A taken buffer is cleared and
 /// filled exactly as a fresh one would be, so the values are the same.
-mod storage_pool {
+pub(crate) mod storage_pool {
     use super::Number;
     use std::cell::RefCell;
     use std::collections::VecDeque;
@@ -97,7 +97,7 @@ mod storage_pool {
 
     /// A buffer of `len` copies of `fill`: the newest kept one of exactly that capacity
     /// if any, else a new one.
-    pub(super) fn take(len: usize, fill: Number) -> Vec<Number> {
+    pub(crate) fn take(len: usize, fill: Number) -> Vec<Number> {
         if len >= MIN_LEN
             && let Ok(Some(mut v)) = POOL.try_with(|p| {
                 let mut p = p.borrow_mut();
@@ -115,14 +115,14 @@ mod storage_pool {
 
     /// The capacities of the kept buffers, oldest first (tests).
     #[cfg(test)]
-    pub(super) fn sizes() -> Vec<usize> {
+    pub(crate) fn sizes() -> Vec<usize> {
         POOL.with(|p| p.borrow().iter().map(Vec::capacity).collect())
     }
 
     /// Keeps `v`'s buffer for a later [`take`], in place of the one kept longest when
     /// the pool is full (so that buffers of a finished solve's sizes give way to the
     /// next solve's).
-    pub(super) fn give(v: Vec<Number>) {
+    pub(crate) fn give(v: Vec<Number>) {
         if v.capacity() < MIN_LEN {
             return;
         }

@@ -127,12 +127,22 @@ pub struct GenTMatrix {
     cache: MatrixCache,
 }
 
+impl Drop for GenTMatrix {
+    fn drop(&mut self) {
+        // wingman patch: the values' buffer goes back to the per-thread pool the dense
+        // vectors use, for the next matrix of this pattern (see `new`).
+        crate::dense_vector::storage_pool::give(std::mem::take(&mut self.values));
+    }
+}
+
 impl GenTMatrix {
     pub fn new(space: Rc<GenTMatrixSpace>) -> Self {
         let nz = space.nonzeros() as usize;
         let initialized = nz == 0;
         Self {
-            values: vec![0.0; nz],
+            // wingman patch: a pooled buffer of this length if one is kept, zeroed as a
+            // new one would be (the solver makes a Jacobian and a Hessian per iterate).
+            values: crate::dense_vector::storage_pool::take(nz, 0.0),
             space,
             initialized,
             cache: MatrixCache::new(),
@@ -477,12 +487,22 @@ pub struct SymTMatrix {
     cache: MatrixCache,
 }
 
+impl Drop for SymTMatrix {
+    fn drop(&mut self) {
+        // wingman patch: the values' buffer goes back to the per-thread pool the dense
+        // vectors use, for the next matrix of this pattern (see `new`).
+        crate::dense_vector::storage_pool::give(std::mem::take(&mut self.values));
+    }
+}
+
 impl SymTMatrix {
     pub fn new(space: Rc<SymTMatrixSpace>) -> Self {
         let nz = space.nonzeros() as usize;
         let initialized = nz == 0;
         Self {
-            values: vec![0.0; nz],
+            // wingman patch: a pooled buffer of this length if one is kept, zeroed as a
+            // new one would be (the solver makes a Jacobian and a Hessian per iterate).
+            values: crate::dense_vector::storage_pool::take(nz, 0.0),
             space,
             initialized,
             cache: MatrixCache::new(),
@@ -784,6 +804,32 @@ mod tests {
         let mut v = space.make_new_dense();
         v.set_values(values);
         Box::new(v)
+    }
+
+    /// Wingman patch: a dropped matrix's values go to the dense vectors' per-thread pool,
+    /// and a new matrix of that many nonzeros takes them back zeroed, as a fresh one starts
+    /// (removing the pool's clear fails it); a pattern of another size gets its own.
+    #[test]
+    fn a_matrix_takes_a_recycled_buffer_zeroed() {
+        let n = 40;
+        let rows: Vec<Index> = (1..=n as Index).collect();
+        let gen_space = GenTMatrixSpace::new(n as Index, n as Index, rows.clone(), rows.clone());
+        let sym_space = SymTMatrixSpace::new(n as Index, rows.clone(), rows.clone());
+        let mut g = GenTMatrix::new(Rc::clone(&gen_space));
+        g.set_values(&vec![7.0; n]);
+        drop(g);
+        assert!(crate::dense_vector::storage_pool::sizes().contains(&n));
+        let g = GenTMatrix::new(Rc::clone(&gen_space));
+        assert_eq!(g.values(), vec![0.0; n].as_slice());
+        let mut s = SymTMatrix::new(Rc::clone(&sym_space));
+        s.values_mut().fill(-3.0);
+        drop(s);
+        let s = SymTMatrix::new(Rc::clone(&sym_space));
+        assert_eq!(s.values(), vec![0.0; n].as_slice());
+        let wider = GenTMatrixSpace::new(n as Index, n as Index + 1, rows.clone(), rows);
+        let w = GenTMatrix::new(wider);
+        assert_eq!(w.values().len(), n);
+        assert!(w.values().iter().all(|&v| v == 0.0));
     }
 
     #[test]

@@ -1592,9 +1592,18 @@ impl OrigIpoptNlp {
         let a = self.adapter.borrow();
         let cls = a.classification();
         let mut full = vec![0.0; cls.n_full_x as usize];
-        let vals = dx.expanded_values();
-        for (var_idx, &full_idx) in cls.x_not_fixed_map.iter().enumerate() {
-            full[full_idx as usize] = vals[var_idx];
+        // wingman patch: the values read in place (`expanded_values` copied them into a
+        // new vector on every call); a homogeneous vector gives its scalar.
+        if dx.is_homogeneous() {
+            let v = dx.scalar();
+            for &full_idx in cls.x_not_fixed_map.iter() {
+                full[full_idx as usize] = v;
+            }
+        } else {
+            let vals = dx.values();
+            for (var_idx, &full_idx) in cls.x_not_fixed_map.iter().enumerate() {
+                full[full_idx as usize] = vals[var_idx];
+            }
         }
         for (i, &full_idx) in cls.x_fixed_map.iter().enumerate() {
             full[full_idx as usize] = cls.x_fixed_vals[i];
