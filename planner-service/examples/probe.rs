@@ -18,7 +18,11 @@
 //! `PROBE_ITS=1` prints every plan's NLP iterations per solve (deterministic, unlike times),
 //! and with `PROBE_MESH=1` its final mesh's intervals per phase;
 //! `PROBE_OUT=DIR` writes
-//! each plan's `plan.json` / `plan.csv` into `DIR/NAME-SEED/` for the judge.
+//! each plan's `plan.json` / `plan.csv` into `DIR/NAME-SEED/` for the judge;
+//! `PROBE_PAIR="NAME=VALUE"` times every seed twice against itself, with the settings of the
+//! environment (A) and with the override `NAME=VALUE` on top (B), in the order A B B A, and
+//! prints `PAIR name seed A-ms B-ms` (the means of each pair): a comparison that a slow
+//! spell of the host weighs on alike.
 
 use std::time::Duration;
 
@@ -42,19 +46,8 @@ fn extra_options(name: &str) -> Vec<(String, String)> {
         .collect()
 }
 
-fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let filter = args.get(1).cloned().unwrap_or_default();
-    let runs: u64 = args.get(2).and_then(|v| v.parse().ok()).unwrap_or(3);
-    let refs: toml::Table = toml::from_str(
-        &std::fs::read_to_string(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../tools/judge/costs.toml"
-        ))
-        .unwrap_or_default(),
-    )
-    .unwrap_or_default();
-    let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
+/// The planner's settings: the defaults with the `PROBE_*` overrides of the environment.
+fn settings_from_env() -> PlannerSettings {
     let mut s = PlannerSettings::default();
     if let Some(v) = env("PROBE_SW_ITERS") {
         s.swarm.max_iterations = v;
@@ -152,6 +145,40 @@ fn main() {
         s.finalist_nlp.second_order_check = v != 0;
     }
     s.ranking_nlp.extra.extend(extra_options("PROBE_RANK_NLP"));
+    s
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let filter = args.get(1).cloned().unwrap_or_default();
+    let runs: u64 = args.get(2).and_then(|v| v.parse().ok()).unwrap_or(3);
+    let refs: toml::Table = toml::from_str(
+        &std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../tools/judge/costs.toml"
+        ))
+        .unwrap_or_default(),
+    )
+    .unwrap_or_default();
+    let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
+    let s = settings_from_env();
+    // Paired timing: `PROBE_PAIR="NAME=VALUE"` plans every seed with the settings above and
+    // with NAME=VALUE set on top, alternately (A B B A), and prints both times.
+    let pair = std::env::var("PROBE_PAIR").ok().and_then(|kv| {
+        let (name, value) = kv.split_once('=')?;
+        let (name, value) = (name.to_string(), value.to_string());
+        let before = std::env::var(&name).ok();
+        // SAFETY: no other thread runs yet.
+        unsafe { std::env::set_var(&name, &value) };
+        let b = settings_from_env();
+        unsafe {
+            match before {
+                Some(v) => std::env::set_var(&name, v),
+                None => std::env::remove_var(&name),
+            }
+        }
+        Some(b)
+    });
     let mut worst = 0.0f64;
     for (name, _) in BUNDLED {
         if !name.contains(filter.as_str()) {
@@ -167,6 +194,7 @@ fn main() {
         let mut swarm_times = Vec::new();
         let mut line = String::new();
         let mut ratios = Vec::new();
+        let mut pairs: Vec<(f64, f64)> = Vec::new();
         // One planner per scenario, as the service keeps one: its workspace and its
         // estimate of the NLP's set-up time carry over from plan to plan.
         let mut planner = Planner::new(&s);
@@ -177,6 +205,22 @@ fn main() {
                 ..s.clone()
             };
             let budget_ms = env::<u64>("PROBE_DEADLINE_MS").unwrap_or(30_000);
+            if let Some(b) = &pair {
+                let sb = PlannerSettings {
+                    swarm: b.swarm.clone().with_seed(seed),
+                    ..b.clone()
+                };
+                let mut ms = [0.0; 2];
+                for k in [0, 1, 1, 0] {
+                    let settings = if k == 0 { &st } else { &sb };
+                    let deadline = Deadline::after(clock, Duration::from_millis(budget_ms));
+                    let out = planner.plan(&problem, settings, deadline).unwrap();
+                    ms[k] += out.times.total.as_secs_f64() * 1e3 / 2.0;
+                }
+                println!("PAIR {name} {seed} {:.1} {:.1}", ms[0], ms[1]);
+                pairs.push((ms[0], ms[1]));
+                continue;
+            }
             eprintln!("PLAN {name} {seed}");
             let began = std::time::Instant::now();
             let out = planner
@@ -259,6 +303,22 @@ fn main() {
                     out.quality
                 );
             }
+        }
+        if !pairs.is_empty() {
+            let median = |mut v: Vec<f64>| {
+                v.sort_by(f64::total_cmp);
+                v[v.len() / 2]
+            };
+            println!(
+                "{name:<36} A med {:7.1} ms  B med {:7.1} ms  median B/A {:.3} ({} seeds)",
+                median(pairs.iter().map(|p| p.0).collect()),
+                median(pairs.iter().map(|p| p.1).collect()),
+                median(pairs.iter().map(|p| p.1 / p.0).collect()),
+                pairs.len()
+            );
+        }
+        if times.is_empty() {
+            continue;
         }
         times.sort_by(f64::total_cmp);
         let max_ratio = ratios.iter().cloned().fold(0.0, f64::max);
