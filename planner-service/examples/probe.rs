@@ -6,7 +6,8 @@
 //!
 //! Overrides: `PROBE_SW_ITERS`, `PROBE_SW_STALL`, `PROBE_SW_PARTICLES`, `PROBE_SW_THREADS` (the swarm's), `PROBE_STARTS`, `PROBE_FINALISTS`, `PROBE_ROUNDS`, `PROBE_RANK_PTS`,
 //! `PROBE_RANK_S`, `PROBE_MESH_PTS`, `PROBE_MESH_S`, `PROBE_THREADS`, `PROBE_DEFECT_TOL`
-//! (the refinement's tolerance, m), `PROBE_MAX_SPLIT` (its most parts per interval), `PROBE_DUP_TOL` and `PROBE_GAP_TOL` (the finalists'
+//! (the refinement's tolerance, m), `PROBE_MAX_SPLIT` (its most parts per interval),
+//! `PROBE_CROSSING` (the finalists' crossing split's threshold; 0: none), `PROBE_DUP_TOL` and `PROBE_GAP_TOL` (the finalists'
 //! duplicate and gap tolerances),
 //! `PROBE_NLP="name=value;name=value"` (extra solver options; `PROBE_RANK_NLP` and
 //! `PROBE_FINAL_NLP` for the ranking or the working-mesh solves only, `PROBE_FIN_NLP` for the
@@ -46,6 +47,18 @@ fn extra_options(name: &str) -> Vec<(String, String)> {
         .collect()
 }
 
+/// Sets (or with `None` removes) environment variable `name`. Called only between plans,
+/// when the planner's threads have ended and the probe runs on one thread.
+fn set_env(name: &str, value: Option<&str>) {
+    // SAFETY: no other thread runs while the probe changes its environment.
+    unsafe {
+        match value {
+            Some(v) => std::env::set_var(name, v),
+            None => std::env::remove_var(name),
+        }
+    }
+}
+
 /// The planner's settings: the defaults with the `PROBE_*` overrides of the environment.
 fn settings_from_env() -> PlannerSettings {
     let mut s = PlannerSettings::default();
@@ -66,6 +79,9 @@ fn settings_from_env() -> PlannerSettings {
     }
     if let Some(v) = env("PROBE_FINALISTS") {
         s.finalists = v;
+    }
+    if let Some(v) = env::<f64>("PROBE_CROSSING") {
+        s.crossing_split = (v > 0.0).then_some(v);
     }
     if let Some(v) = env("PROBE_DUP_TOL") {
         s.finalist_duplicate_tol = v;
@@ -168,16 +184,10 @@ fn main() {
         let (name, value) = kv.split_once('=')?;
         let (name, value) = (name.to_string(), value.to_string());
         let before = std::env::var(&name).ok();
-        // SAFETY: no other thread runs yet.
-        unsafe { std::env::set_var(&name, &value) };
+        set_env(&name, Some(&value));
         let b = settings_from_env();
-        unsafe {
-            match before {
-                Some(v) => std::env::set_var(&name, v),
-                None => std::env::remove_var(&name),
-            }
-        }
-        Some(b)
+        set_env(&name, before.as_deref());
+        Some((b, name, value, before))
     });
     let mut worst = 0.0f64;
     for (name, _) in BUNDLED {
@@ -205,18 +215,25 @@ fn main() {
                 ..s.clone()
             };
             let budget_ms = env::<u64>("PROBE_DEADLINE_MS").unwrap_or(30_000);
-            if let Some(b) = &pair {
+            if let Some((b, var, value, before)) = &pair {
                 let sb = PlannerSettings {
                     swarm: b.swarm.clone().with_seed(seed),
                     ..b.clone()
                 };
                 let mut ms = [0.0; 2];
                 for k in [0, 1, 1, 0] {
-                    let settings = if k == 0 { &st } else { &sb };
+                    // B also plans with the variable set, for what reads it at plan time.
+                    let (settings, env_value) = if k == 0 {
+                        (&st, before.as_deref())
+                    } else {
+                        (&sb, Some(value.as_str()))
+                    };
+                    set_env(var, env_value);
                     let deadline = Deadline::after(clock, Duration::from_millis(budget_ms));
                     let out = planner.plan(&problem, settings, deadline).unwrap();
                     ms[k] += out.times.total.as_secs_f64() * 1e3 / 2.0;
                 }
+                set_env(var, before.as_deref());
                 println!("PAIR {name} {seed} {:.1} {:.1}", ms[0], ms[1]);
                 pairs.push((ms[0], ms[1]));
                 continue;

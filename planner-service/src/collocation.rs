@@ -15,6 +15,6 @@ pub use export::{ExportSettings, export, fly};
 pub use kkt::{KktLabels, KktSolver, StructuredKkt};
 pub use lgr::Lgr;
 pub use mesh::{Layout, Mesh};
-pub use refine::{RefineSettings, interval_errors, refine};
+pub use refine::{RefineSettings, interval_errors, refine, split_crossings};
 pub use solve::{NlpOutcome, NlpSettings, NlpStatus, PrimalDual, SolveBudget, solve};
 pub use transcription::{Transcription, TranscriptionSettings};
