@@ -21,9 +21,10 @@
 //! `PROBE_OUT=DIR` writes
 //! each plan's `plan.json` / `plan.csv` into `DIR/NAME-SEED/` for the judge;
 //! `PROBE_PAIR="NAME=VALUE"` times every seed twice against itself, with the settings of the
-//! environment (A) and with the override `NAME=VALUE` on top (B), in the order A B B A, and
-//! prints `PAIR name seed A-ms B-ms` (the means of each pair): a comparison that a slow
-//! spell of the host weighs on alike.
+//! environment (A) and with the override `NAME=VALUE` on top (B; the variable is also set
+//! while B plans, for what reads it at plan time), in the order A B B A, and prints
+//! `PAIR name seed A-ms B-ms` (the means of each pair) and per scenario the median of the
+//! B/A ratios: a comparison that a slow spell of the host weighs on alike.
 
 use std::time::Duration;
 

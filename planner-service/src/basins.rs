@@ -169,12 +169,8 @@ pub fn candidates(
     threads: usize,
     cost: impl Fn(&Trajectory) -> f64 + Sync,
 ) -> Vec<Trajectory> {
-    let three_d = problem.dim() == 3;
     let xy = |tr: &Trajectory| -> Vec<[f64; 3]> {
-        tr.states
-            .iter()
-            .map(|s| [s[0], s[1], if three_d { s[2] } else { 0.0 }])
-            .collect()
+        tr.states.iter().map(|s| problem.position(s)).collect()
     };
     let mut taken = vec![signature(problem, &xy(first))];
     let mut out = vec![first.clone()];

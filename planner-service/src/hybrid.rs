@@ -204,9 +204,10 @@ impl Default for PlannerSettings {
             // 0.3: a crossing steps the exposure by 0.96-1.0 on the canonical scenarios
             // (0.1-0.95 split the same intervals), where nothing else moves it by 0.3
             // within one interval. Paired timing against no split (each seed A B B A,
-            // median of the per-seed ratios): 2d-min-time-unavoidable 0.78,
-            // 3d-min-time-unavoidable 0.87, 3d-fixed-time-unavoidable 0.95, the others
-            // 0.99-1.04; costs the same or lower (docs/BENCHMARKS.md).
+            // median of the per-seed ratios, seeds 1-6): 2d-min-time-unavoidable 0.81,
+            // 3d-min-time-unavoidable 0.85, the rendezvous-unavoidable and
+            // 3d-fixed-time-unavoidable ones 0.95-0.97, the others 0.99-1.045 (pairs of the
+            // same settings: 0.96-1.01); costs the same or lower (docs/BENCHMARKS.md).
             crossing_split: Some(0.3),
         }
     }
@@ -903,11 +904,7 @@ pub fn trajectory_cost(problem: &Problem, tr: &Trajectory) -> f64 {
         }
     }
     let exposure = crate::metrics::simpson_by(&tr.times, |k| {
-        let s = &tr.states[k];
-        problem.exposure(
-            &[s[0], s[1], if problem.dim() == 3 { s[2] } else { 0.0 }],
-            tr.times[k],
-        )
+        problem.exposure(&problem.position(&tr.states[k]), tr.times[k])
     });
     let w = &problem.weights;
     let run = (1.0 - w.beta) * effort + w.beta * exposure;

@@ -167,10 +167,17 @@ impl Problem {
         }
     }
 
+    /// The position `[x, y, z]` of a state in model order (z = 0 in 2-D, where the third
+    /// entry is the heading).
+    pub fn position(&self, state: &[f64; 7]) -> [f64; 3] {
+        let z = if self.dim() == 3 { state[2] } else { 0.0 };
+        [state[0], state[1], z]
+    }
+
     /// The final position the plan must reach at time `t` (the final point, or the lead).
     pub fn final_position_at(&self, t: f64) -> [f64; 3] {
         match (&self.final_state, &self.lead) {
-            (Some(f), _) => [f[0], f[1], if self.dim() == 3 { f[2] } else { 0.0 }],
+            (Some(f), _) => self.position(f),
             (None, Some(lead)) => lead.at(t).position,
             (None, None) => [self.x0[0], self.x0[1], 0.0],
         }

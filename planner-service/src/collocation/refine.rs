@@ -186,8 +186,7 @@ pub fn split_crossings(
             for q in 0..=CROSSING_SAMPLES {
                 let t = t_start + duration * (begin + frac * q as f64 / CROSSING_SAMPLES as f64);
                 if let Some((state, _)) = path.at(t) {
-                    let z = if problem.dim() == 3 { state[2] } else { 0.0 };
-                    let e = problem.exposure(&[state[0], state[1], z], t);
+                    let e = problem.exposure(&problem.position(&state), t);
                     lo = lo.min(e);
                     hi = hi.max(e);
                 }
