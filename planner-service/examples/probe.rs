@@ -12,7 +12,8 @@
 //! `PROBE_NLP="name=value;name=value"` (extra solver options; `PROBE_RANK_NLP` and
 //! `PROBE_FINAL_NLP` for the ranking or the working-mesh solves only, `PROBE_FIN_NLP` for the
 //! finalists' only, `PROBE_REF_NLP` for the refined solves only); `PROBE_FIN_TOL`, `PROBE_FIN_ACC`, `PROBE_FIN_SOC=0|1` (the finalists'
-//! tolerance, acceptable tolerance, second-order check); `PROBE_FIRST_SEED` (1);
+//! tolerance, acceptable tolerance, second-order check); `PROBE_RANK_FEAS` (the largest
+//! scaled violation of a ranking solve that still ranks); `PROBE_FIRST_SEED` (1);
 //! `PROBE_KKT=feral|structured` (the KKT linear solver of every NLP solve);
 //! `PROBE_SOC=0|1` and `PROBE_TOL` (the second-order check and the tolerance of the
 //! refined solves);
@@ -160,6 +161,9 @@ fn settings_from_env() -> PlannerSettings {
     }
     if let Some(v) = env::<u8>("PROBE_FIN_SOC") {
         s.finalist_nlp.second_order_check = v != 0;
+    }
+    if let Some(v) = env("PROBE_RANK_FEAS") {
+        s.ranking_feasibility_tol = v;
     }
     s.ranking_nlp.extra.extend(extra_options("PROBE_RANK_NLP"));
     s
