@@ -10,9 +10,9 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::thread::JoinHandle;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
-use crossbeam::channel::{self, Receiver, Sender};
+use crossbeam::channel::{self, Receiver, RecvTimeoutError, Sender};
 use tracing::{error, info, info_span};
 use wingman_interfaces::Trigger;
 
@@ -165,20 +165,27 @@ impl Solver {
     }
 }
 
-/// Joins the solve thread once it has ended, waiting at most `timeout` and draining its
-/// results meanwhile (so it is never blocked sending one); past it the thread is left to
-/// end with the process.
-fn join_within(thread: JoinHandle<()>, results: &Receiver<SolveResult>, timeout: Duration) {
+/// Joins the solve thread once it has ended, waiting at most `timeout` (wall time) and
+/// draining its results meanwhile (so it is never blocked sending one); past it the thread
+/// is left to end with the process. Whether it was joined.
+///
+/// The thread drops its end of `results` as it returns, a moment before it counts as
+/// finished (its thread-locals, such as the solver's buffer pool, are freed in between):
+/// the wait then sleeps in steps rather than spinning on the closed channel.
+fn join_within<T>(thread: JoinHandle<()>, results: &Receiver<T>, timeout: Duration) -> bool {
     let step = Duration::from_millis(5);
-    let mut waited = Duration::ZERO;
-    while !thread.is_finished() && waited < timeout {
-        let _ = results.recv_timeout(step);
-        waited += step;
+    let began = Instant::now();
+    while !thread.is_finished() && began.elapsed() < timeout {
+        if let Err(RecvTimeoutError::Disconnected) = results.recv_timeout(step) {
+            std::thread::sleep(Duration::from_millis(1));
+        }
     }
     if thread.is_finished() {
         let _ = thread.join();
+        true
     } else {
         error!("the solve thread did not end within {timeout:?}; leaving it to the process exit");
+        false
     }
 }
 
@@ -340,6 +347,41 @@ mod tests {
         assert_eq!(parse_cpu_ticks(line), Some(38));
         assert_eq!(parse_cpu_ticks(b"4242 (x) S 1 2"), None);
         assert!(process_cpu_time().is_some(), "/proc/self/stat is readable");
+    }
+
+    /// A thread that closes its results channel and then takes a while to end (as the
+    /// solve thread does while its thread-locals are freed) is waited for, in wall time:
+    /// counting 5 ms per `recv` on the closed channel gave up on it at once.
+    #[test]
+    fn a_thread_that_closed_its_channel_is_still_waited_for() {
+        let (tx, rx) = channel::bounded::<u32>(1);
+        let thread = std::thread::spawn(move || {
+            drop(tx);
+            std::thread::sleep(Duration::from_millis(60));
+        });
+        let began = Instant::now();
+        assert!(join_within(thread, &rx, Duration::from_secs(5)), "joined");
+        assert!(
+            began.elapsed() >= Duration::from_millis(50),
+            "it waited for the thread"
+        );
+
+        // And one that does not end in time is left, after the timeout.
+        let (_tx, rx) = channel::bounded::<u32>(1);
+        let (stop_tx, stop_rx) = channel::bounded::<()>(1);
+        let thread = std::thread::spawn(move || {
+            let _ = stop_rx.recv();
+        });
+        let began = Instant::now();
+        assert!(
+            !join_within(thread, &rx, Duration::from_millis(50)),
+            "not joined"
+        );
+        assert!(
+            began.elapsed() >= Duration::from_millis(50),
+            "the whole timeout"
+        );
+        let _ = stop_tx.send(());
     }
 
     #[test]
