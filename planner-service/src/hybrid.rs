@@ -122,7 +122,7 @@ impl Default for PlannerSettings {
             // costs as at the working tolerance, 15 % less CPU (docs/BENCHMARKS.md). An
             // acceptable stop must still be feasible enough to rank (below
             // `ranking_feasibility_tol`, which moves with it): with the solver's default
-            // (1e-2) and a ranking tolerance of 1e-4, the swarm's own start of
+            // (1e-2) and `ranking_feasibility_tol` at 1e-4, the swarm's own start of
             // 2d-fixed-time-unavoidable, seed 3, stopped at 3e-4 and was dropped, and the
             // plan landed in a basin 18 % higher.
             ranking_nlp: NlpSettings {
