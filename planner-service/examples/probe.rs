@@ -49,6 +49,12 @@ fn extra_options(name: &str) -> Vec<(String, String)> {
         .collect()
 }
 
+/// The median (upper, for an even count) of `v`, which it leaves sorted.
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
 /// Sets (or with `None` removes) environment variable `name`. Called only between plans,
 /// when the planner's threads have ended and the probe runs on one thread.
 fn set_env(name: &str, value: Option<&str>) {
@@ -327,30 +333,24 @@ fn main() {
             }
         }
         if !pairs.is_empty() {
-            let median = |mut v: Vec<f64>| {
-                v.sort_by(f64::total_cmp);
-                v[v.len() / 2]
-            };
             println!(
                 "{name:<36} A med {:7.1} ms  B med {:7.1} ms  median B/A {:.3} ({} seeds)",
-                median(pairs.iter().map(|p| p.0).collect()),
-                median(pairs.iter().map(|p| p.1).collect()),
-                median(pairs.iter().map(|p| p.1 / p.0).collect()),
+                median(&mut pairs.iter().map(|p| p.0).collect::<Vec<_>>()),
+                median(&mut pairs.iter().map(|p| p.1).collect::<Vec<_>>()),
+                median(&mut pairs.iter().map(|p| p.1 / p.0).collect::<Vec<_>>()),
                 pairs.len()
             );
         }
         if times.is_empty() {
             continue;
         }
-        times.sort_by(f64::total_cmp);
         let max_ratio = ratios.iter().cloned().fold(0.0, f64::max);
         worst = worst.max(max_ratio);
-        swarm_times.sort_by(f64::total_cmp);
         println!(
             "{name:<36} med {:7.1} ms max {:7.1} swarm med {:5.1} | cost/ref max {:.5} [{}] | {line}",
-            times[times.len() / 2],
+            median(&mut times),
             times[times.len() - 1],
-            swarm_times[swarm_times.len() / 2],
+            median(&mut swarm_times),
             max_ratio,
             ratios
                 .iter()

@@ -258,7 +258,7 @@ mod tests {
             let mut t = a;
             while t <= b {
                 let (x, _) = self.path.at(t).unwrap();
-                let e = self.problem.exposure(&[x[0], x[1], 0.0], t);
+                let e = self.problem.exposure(&self.problem.position(&x), t);
                 (lo, hi) = (lo.min(e), hi.max(e));
                 t += 0.25;
             }
