@@ -48,10 +48,7 @@ fn row(out: &mut String, f: &FieldInfo) {
 }
 
 fn type_name_of<T: Wire>() -> &'static str {
-    // The iceoryx2 type name: `wingman::<NAME>` for every wire type (see `wire_struct!`).
-    // SAFETY: `type_name` is unsafe only because iceoryx2 requires implementors to keep
-    // it unique; calling it has no precondition.
-    unsafe { <T as iceoryx2::prelude::ZeroCopySend>::type_name() }
+    T::TYPE_NAME
 }
 
 fn enum_table<E: WireEnum>(out: &mut String) {

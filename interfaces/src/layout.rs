@@ -118,9 +118,12 @@ unsafe impl<T: Plain, const N: usize> Plain for [T; N] {
 /// # Safety
 /// Implemented only by [`wire_struct!`], which guarantees `#[repr(C)]`, plain fields and
 /// no padding.
-pub unsafe trait Wire: Plain + iceoryx2::prelude::ZeroCopySend {
-    /// Type name in the interface document and in iceoryx2's type check.
+pub unsafe trait Wire: Plain + Transport {
+    /// Name in the interface document.
     const NAME: &'static str;
+    /// Type name in iceoryx2's type check (`wingman::<NAME>`), the same with or without
+    /// the `iceoryx2` feature.
+    const TYPE_NAME: &'static str;
     /// One paragraph for the interface document.
     const DOC: &'static str;
     /// Every field, in declaration (and offset) order.
@@ -172,6 +175,18 @@ pub unsafe trait Wire: Plain + iceoryx2::prelude::ZeroCopySend {
         first_non_finite_in(self.as_bytes(), Self::fields())
     }
 }
+
+/// What a wire type needs to travel: iceoryx2's `ZeroCopySend` with the `iceoryx2`
+/// feature, nothing without it (code that only computes with messages links no IPC).
+#[cfg(feature = "iceoryx2")]
+pub trait Transport: iceoryx2::prelude::ZeroCopySend {}
+#[cfg(feature = "iceoryx2")]
+impl<T: iceoryx2::prelude::ZeroCopySend> Transport for T {}
+/// What a wire type needs to travel: nothing without the `iceoryx2` feature.
+#[cfg(not(feature = "iceoryx2"))]
+pub trait Transport {}
+#[cfg(not(feature = "iceoryx2"))]
+impl<T> Transport for T {}
 
 /// `read_from_bytes` was given the wrong number of bytes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
@@ -225,9 +240,9 @@ macro_rules! wire_struct {
         }
     ) => {
         $(#[doc = $doc])*
-        #[derive(Debug, Clone, Copy, PartialEq, $crate::ZeroCopySend)]
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        #[cfg_attr(feature = "iceoryx2", derive($crate::ZeroCopySend), type_name($tn))]
         #[repr(C)]
-        #[type_name($tn)]
         pub struct $name {
             $( $(#[doc = $fdoc])* pub $field: $ty, )*
         }
@@ -254,6 +269,7 @@ macro_rules! wire_struct {
         // SAFETY: see the `Plain` impl above.
         unsafe impl $crate::layout::Wire for $name {
             const NAME: &'static str = stringify!($name);
+            const TYPE_NAME: &'static str = $tn;
             const DOC: &'static str = concat!($($doc, "\n",)*);
             fn fields() -> &'static [$crate::layout::FieldInfo] {
                 const FIELDS: &[$crate::layout::FieldInfo] = &[$(

@@ -44,6 +44,7 @@ pub use track::TrackFix;
 pub use validate::{Checked, ValidationError};
 
 /// Re-exported so the derive in [`wire_struct!`] resolves in this crate and in users'.
+#[cfg(feature = "iceoryx2")]
 pub use iceoryx2::prelude::ZeroCopySend;
 
 /// Version of this contract. A message carrying another version is rejected.

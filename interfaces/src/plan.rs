@@ -1,3 +1,4 @@
+#[cfg(feature = "iceoryx2")]
 use crate::ZeroCopySend;
 use crate::message::{Message, validate_common};
 use crate::validate::{self, Checked, ValidationError};

@@ -16,10 +16,10 @@ use std::time::{Duration, Instant};
 
 use iceoryx2::port::update_connections::UpdateConnections;
 use wingman_interfaces::*;
-use wingman_planner::clock::MonotonicClock;
-use wingman_planner::scenario::bundled;
-use wingman_planner::service::ipc;
+use wingman_ipc as ipc;
 use wingman_planner::service::{RunOptions, ServiceConfig, Shutdown};
+use wingman_planning::clock::MonotonicClock;
+use wingman_planning::scenario::bundled;
 
 /// CPU time of this process: (stat ticks in ns, schedstat ns over all threads).
 fn cpu_ns() -> (u64, u64) {

@@ -29,11 +29,11 @@
 
 use std::time::Duration;
 
-use wingman_planner::clock::{Deadline, MonotonicClock};
-use wingman_planner::collocation::KktSolver;
-use wingman_planner::hybrid::{Planner, PlannerSettings};
-use wingman_planner::problem::Problem;
-use wingman_planner::scenario::{BUNDLED, bundled};
+use wingman_planning::clock::{Deadline, MonotonicClock};
+use wingman_planning::collocation::KktSolver;
+use wingman_planning::hybrid::{Planner, PlannerSettings};
+use wingman_planning::problem::Problem;
+use wingman_planning::scenario::{BUNDLED, bundled};
 
 fn env<T: std::str::FromStr>(name: &str) -> Option<T> {
     std::env::var(name).ok().and_then(|v| v.parse().ok())
@@ -364,10 +364,10 @@ fn main() {
         "KKT factorisations: {} by block elimination ({} without pivot groups, {} stopped on a \
          surplus of negative eigenvalues), {} handed to FERAL; {} solves took their \
          workspace from the pool",
-        wingman_planner::collocation::kkt::block_factorizations_total(),
-        wingman_planner::collocation::kkt::plain_factorizations_total(),
-        wingman_planner::collocation::kkt::surplus_stops_total(),
-        wingman_planner::collocation::kkt::feral_fallbacks_total(),
-        wingman_planner::collocation::kkt::workspace_reuses_total()
+        wingman_planning::collocation::kkt::block_factorizations_total(),
+        wingman_planning::collocation::kkt::plain_factorizations_total(),
+        wingman_planning::collocation::kkt::surplus_stops_total(),
+        wingman_planning::collocation::kkt::feral_fallbacks_total(),
+        wingman_planning::collocation::kkt::workspace_reuses_total()
     );
 }

@@ -1,26 +1,7 @@
-//! The wingman planning library: the numerical core (vehicle models, threat exposure,
-//! moving-threat estimation, re-plan timing, trajectory metrics), the scenario loader, and
-//! (in later modules) the hybrid planner and the planner service.
-//!
-//! One module per idea (see `../shared/STYLE.md`): every module is named for what it does.
+//! The wingman planner service: the planner as the customer deploys it — its own process,
+//! talking to the rest of the aircraft only through the messages of `wingman-interfaces`
+//! over iceoryx2 (`wingman-ipc`), planning with `wingman-planning` only when triggered,
+//! under a compute budget. Also the offline `plan` command of the `wingman-planner` binary.
 
-pub mod basins;
-pub mod clock;
-pub mod collocation;
-pub mod dynamics;
-pub mod estimation;
-pub mod hybrid;
-pub mod lead;
-pub mod logging;
-pub mod metrics;
 pub mod offline;
-pub mod plot;
-pub mod problem;
-pub mod replan;
-pub mod scenario;
-pub mod seeding;
 pub mod service;
-pub mod swarm;
-pub mod threat;
-pub mod tracking;
-pub mod trajectory;

@@ -8,10 +8,10 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand};
-use wingman_planner::clock::MonotonicClock;
 use wingman_planner::offline::{PlanRequest, plan_scenario, summary};
-use wingman_planner::scenario::load_by_path_or_name;
 use wingman_planner::service::{RunOptions, ServiceConfig, Shutdown};
+use wingman_planning::clock::MonotonicClock;
+use wingman_planning::scenario::load_by_path_or_name;
 
 /// Onboard route planner of the loyal wingman.
 #[derive(Parser)]
@@ -66,7 +66,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    wingman_planner::logging::init();
+    wingman_ipc::logging::init();
     match Cli::parse().command {
         Command::Serve {
             config,

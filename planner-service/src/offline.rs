@@ -7,10 +7,10 @@ use std::time::Duration;
 use serde_json::json;
 use wingman_interfaces::{Model, Quality};
 
-use crate::clock::{Clock, Deadline};
-use crate::hybrid::{PlanOutcome, Planner, PlannerSettings};
-use crate::problem::Problem;
-use crate::scenario::Scenario;
+use wingman_planning::clock::{Clock, Deadline};
+use wingman_planning::hybrid::{PlanOutcome, Planner, PlannerSettings};
+use wingman_planning::problem::Problem;
+use wingman_planning::scenario::Scenario;
 
 /// What to plan and where to write it.
 #[derive(Debug, Clone)]
@@ -64,8 +64,8 @@ fn draw_plan(
     planner: &Planner,
     o: &PlanOutcome,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    use crate::plot::{MapMarker, MapPath, MapPlot, Stroke, draw_map};
     use plotters::style::RGBColor;
+    use wingman_plot::{MapMarker, MapPath, MapPlot, Stroke, draw_map};
     let xy = |s: &[f64; 7]| [s[0], s[1]];
     let mut paths = Vec::new();
     for (k, (_, points)) in planner.swarm_workspace().seed_paths().enumerate() {
@@ -179,7 +179,7 @@ pub fn write_outputs(
 
 /// The one-line summary printed by the command.
 pub fn summary(sc: &Scenario, o: &PlanOutcome) -> String {
-    let exposure = crate::metrics::simpson_by(&o.trajectory.times, |_| 0.0);
+    let exposure = wingman_planning::metrics::simpson_by(&o.trajectory.times, |_| 0.0);
     let _ = exposure;
     format!(
         "{}: quality {} cost {:.6} final time {:.2} s | swarm {:.1} ms ({} it, cost {:.4}) nlp {:.1} ms (it {:?}) export {:.1} ms total {:.1} ms",

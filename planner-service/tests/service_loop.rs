@@ -1,14 +1,13 @@
-//! The message loop driven pass by pass from the test (`service_support::Driven`), so that
+//! The message loop driven pass by pass from the test (`common::Driven`), so that
 //! a test decides which inputs arrive while a plan is in flight. Each test names the
 //! protection it checks; each fails without it.
 
-mod service_support;
+mod common;
 
 use std::time::Duration;
 
-use service_support::*;
-use wingman_interfaces::*;
-use wingman_planner::service::export::state_at;
+use common::*;
+use wingman_planning::plan_message::state_at;
 
 /// B1: a pop-up that arrives while a plan is in flight, clear of the old plan but on the
 /// new one, re-plans once the new plan is taken (`on_result` checks the threats newer than
@@ -108,7 +107,7 @@ fn a_deviation_coalesced_with_a_popup_splices_from_the_ownship() {
 #[test]
 fn a_huge_plan_id_from_the_ownship_does_not_overflow_the_plan_ids() {
     let mut d = Driven::new(test_config(&vehicle("plan-id-max")));
-    let sc = wingman_planner::scenario::bundled("2d-min-time-avoidable")
+    let sc = wingman_planning::scenario::bundled("2d-min-time-avoidable")
         .unwrap()
         .unwrap();
     d.h.set_time(0.0);
@@ -181,7 +180,7 @@ fn a_repeated_tasking_with_a_new_revision_keeps_the_passed_targets() {
 #[test]
 fn a_failed_first_plan_is_tried_again() {
     let mut d = Driven::new(test_config(&vehicle("first-fails")));
-    let sc = wingman_planner::scenario::bundled("3d-min-time-avoidable")
+    let sc = wingman_planning::scenario::bundled("3d-min-time-avoidable")
         .unwrap()
         .unwrap();
     let mut t = tasking_from(&sc, 1);
@@ -220,7 +219,7 @@ fn a_failed_first_plan_is_tried_again() {
 fn a_model_change_starts_from_the_ownship_in_the_new_model() {
     let mut d = Driven::new(test_config(&vehicle("model-change")));
     d.first_plan("2d-min-time-avoidable");
-    let sc3 = wingman_planner::scenario::bundled("3d-min-time-avoidable")
+    let sc3 = wingman_planning::scenario::bundled("3d-min-time-avoidable")
         .unwrap()
         .unwrap();
     let t3 = tasking_from(&sc3, 2);
@@ -264,7 +263,7 @@ fn a_model_change_starts_from_the_ownship_in_the_new_model() {
 #[test]
 fn a_restart_does_not_dead_reckon_a_stale_ownship_state() {
     let mut d = Driven::new(test_config(&vehicle("stale-ownship")));
-    let sc = wingman_planner::scenario::bundled("2d-min-time-avoidable")
+    let sc = wingman_planning::scenario::bundled("2d-min-time-avoidable")
         .unwrap()
         .unwrap();
     let north = std::f64::consts::FRAC_PI_2;

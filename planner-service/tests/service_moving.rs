@@ -4,13 +4,12 @@
 //! `t_r`, a mission clock reaching `t_r - budget` makes a `ScheduledReplan` plan that
 //! commits at `t_r`.
 
-mod service_support;
+mod common;
 
 use std::time::Duration;
 
-use service_support::*;
-use wingman_interfaces::*;
-use wingman_planner::scenario::bundled;
+use common::*;
+use wingman_planning::scenario::bundled;
 
 #[test]
 fn a_moving_threat_is_tracked_and_its_t_r_schedules_a_replan() {
@@ -21,7 +20,7 @@ fn a_moving_threat_is_tracked_and_its_t_r_schedules_a_replan() {
     // swarm-only plan within it: the quality is not checked here.)
     cfg.budget.plan_3d_ms = 5000;
     let budget_s = cfg.budget.plan_3d_ms as f64 * 1e-3;
-    let service = ServiceThread::start(cfg);
+    let service = ServiceThread::start(cfg).expect("start the service");
     let mut h = FakeHarness::new(&v);
     assert!(h.wait_until(Duration::from_secs(20), |h| h.status.is_some()));
     let sc = bundled("3d-min-time-moving-threat").unwrap().unwrap();
@@ -120,7 +119,7 @@ fn a_moving_threat_is_tracked_and_its_t_r_schedules_a_replan() {
     own.time_s = t_r - budget_s;
     own.model = Model::ThreeD.to_wire();
     own.plan_id = first.plan_id;
-    own.state = wingman_planner::service::export::state_at(&first, t_r - budget_s).unwrap();
+    own.state = wingman_planning::plan_message::state_at(&first, t_r - budget_s).unwrap();
     h.send_ownship(own);
     h.wake();
     assert!(
@@ -147,5 +146,5 @@ fn a_moving_threat_is_tracked_and_its_t_r_schedules_a_replan() {
         second.start_time_s,
         second.next_replan()
     );
-    service.stop(&h);
+    service.stop(|| h.wake()).expect("the service stops");
 }

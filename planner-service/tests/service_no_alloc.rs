@@ -16,20 +16,19 @@
 //! own thread). Not covered: iceoryx2's `WaitSet::wait_and_process_once`, which collects
 //! the ready file descriptors of each wake-up into a small `Vec`.
 
-mod service_support;
+mod common;
 
 use std::time::{Duration, Instant};
 
-use service_support::*;
-use wingman_interfaces::*;
-use wingman_planner::clock::MonotonicClock;
-use wingman_planner::scenario::bundled;
-use wingman_planner::service::export::state_at;
+use common::*;
 use wingman_planner::service::{MessageLoop, RunOptions, Shutdown};
+use wingman_planning::clock::MonotonicClock;
+use wingman_planning::plan_message::state_at;
+use wingman_planning::scenario::bundled;
 
-#[path = "support/counting_alloc.rs"]
-mod counting_alloc;
+wingman_testkit::counting_allocator!();
 use counting_alloc::allocations_in;
+use wingman_testkit::counting_alloc;
 
 /// One step of inputs: ownship, lead state, a track fix, a pop-up clear of the plan
 /// (moved a little every time, so it is assessed again), an invalid message.

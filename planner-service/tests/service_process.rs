@@ -10,16 +10,15 @@
 //!
 //! A watchdog kills a child that outlives its time limit.
 
-mod service_support;
+mod common;
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
-use service_support::*;
-use wingman_interfaces::*;
-use wingman_planner::scenario::bundled;
+use common::*;
+use wingman_planning::scenario::bundled;
 
 const BIN: &str = env!("CARGO_BIN_EXE_wingman-planner");
 
@@ -170,7 +169,7 @@ fn the_message_thread_runs_with_the_short_scheduler_slice_and_the_solve_thread_w
             .map(|&(_, s)| s)
             .unwrap_or_else(|| panic!("no thread {name} in {threads:?}"))
     };
-    let configured = wingman_planner::service::ServiceConfig::load(repo().join("planner.toml"))
+    let configured = wingman_ipc::ServiceConfig::load(repo().join("planner.toml"))
         .unwrap()
         .scheduling
         .message_slice_us;
@@ -265,7 +264,7 @@ fn a_restart_after_a_crash_cleans_up_and_takes_the_world_from_history() {
     own.time_s = 5.0;
     own.model = Model::TwoD.to_wire();
     own.plan_id = flown.plan_id;
-    own.state = wingman_planner::service::export::state_at(&flown, 5.0).unwrap();
+    own.state = wingman_planning::plan_message::state_at(&flown, 5.0).unwrap();
     h.send_ownship(own);
     h.wake();
     assert!(
@@ -384,7 +383,7 @@ fn the_unit_file_and_the_deployment_doc_match_the_binary() {
         .trim()
         .parse()
         .unwrap();
-    let cfg = wingman_planner::service::ServiceConfig::load(repo().join("planner.toml")).unwrap();
+    let cfg = wingman_ipc::ServiceConfig::load(repo().join("planner.toml")).unwrap();
     let largest_s = cfg.budget.plan_2d_ms.max(cfg.budget.plan_3d_ms) as f64 / 1e3;
     assert!(
         stop_s > largest_s + 2.0,

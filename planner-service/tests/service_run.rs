@@ -1,5 +1,5 @@
 //! The planner service driven in-process over real iceoryx2 services by a small fake
-//! harness (`service_support`), each test on its own vehicle id:
+//! harness (`common`), each test on its own vehicle id:
 //!
 //! - a tasking gives a plan of quality `Optimal` or `Feasible`, starting at the tasking's
 //!   start; an invalid message is rejected and counted and changes nothing; a pop-up clear
@@ -7,14 +7,13 @@
 //! - a burst of 50 pop-ups that each touch the plan, within one second of mission time,
 //!   gives at most 3 plans, and the coalesced counter accounts for the rest.
 
-mod service_support;
+mod common;
 
 use std::time::Duration;
 
-use service_support::*;
-use wingman_interfaces::*;
+use common::*;
 use wingman_planner::service::ExitReason;
-use wingman_planner::service::export::state_at;
+use wingman_planning::plan_message::state_at;
 
 const PLAN_WAIT: Duration = Duration::from_secs(120);
 
@@ -22,9 +21,9 @@ const PLAN_WAIT: Duration = Duration::from_secs(120);
 /// time 0 and waits for the first plan.
 fn first_plan(tag: &str) -> (ServiceThread, FakeHarness) {
     let v = vehicle(tag);
-    let service = ServiceThread::start(test_config(&v));
+    let service = ServiceThread::start(test_config(&v)).expect("start the service");
     let mut h = FakeHarness::new(&v);
-    h.first_plan_of("2d-min-time-avoidable", PLAN_WAIT);
+    first_plan_of(&mut h, "2d-min-time-avoidable", PLAN_WAIT);
     (service, h)
 }
 
@@ -114,7 +113,7 @@ fn a_tasking_gives_a_plan_and_bad_or_clear_inputs_change_nothing() {
     // The valid message's sequence is echoed; the foreign one's is not trusted.
     assert_eq!(s.last_input_sequence, h.sequence);
 
-    let summary = service.stop(&h);
+    let summary = service.stop(|| h.wake()).expect("the service stops");
     assert_eq!(summary.exit, ExitReason::Requested);
     assert_eq!(summary.status.plans_made, 1);
 }
@@ -205,5 +204,5 @@ fn a_burst_of_popups_is_coalesced_into_few_plans() {
         &x0[..3],
         &expected[..3]
     );
-    service.stop(&h);
+    service.stop(|| h.wake()).expect("the service stops");
 }

@@ -6,16 +6,16 @@
 //! `x = 200 t`, sampled every second for 100 s; it passes `x = 10 km` at `t = 50 s`.
 
 use wingman_interfaces::*;
-use wingman_planner::estimation::{Estimate, GaussMarkov, MovingThreat, Road};
-use wingman_planner::replan::PlanPoint;
-use wingman_planner::service::ServiceConfig;
-use wingman_planner::service::config::ConfigError;
-use wingman_planner::service::export::{
+use wingman_ipc::ServiceConfig;
+use wingman_ipc::config::ConfigError;
+use wingman_planner::service::triggers::*;
+use wingman_planning::estimation::{Estimate, GaussMarkov, MovingThreat, Road};
+use wingman_planning::plan_message::{
     PlanInfo, sample_times, set_next_replan, state_at, write_plan,
 };
-use wingman_planner::service::triggers::*;
-use wingman_planner::threat::Superquadric;
-use wingman_planner::trajectory::Trajectory;
+use wingman_planning::replan::PlanPoint;
+use wingman_planning::threat::Superquadric;
+use wingman_planning::trajectory::Trajectory;
 
 fn plan() -> Vec<PlanPoint<2>> {
     (0..=100)

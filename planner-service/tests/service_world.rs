@@ -2,7 +2,7 @@
 //! limits, a threat changing kind, a track fix the filter refuses. Each test names the
 //! protection it checks; each fails without it.
 
-mod service_support;
+mod common;
 
 use std::time::Duration;
 
@@ -21,10 +21,10 @@ fn static_report(id: u32, x: f64) -> ThreatReport {
     r
 }
 
-/// A moving threat of `service_support`, its estimate at 10 s and a little different
+/// A moving threat of `common`, its estimate at 10 s and a little different
 /// per id.
 fn moving_report(id: u32) -> ThreatReport {
-    let mut r = service_support::moving_threat(id);
+    let mut r = common::moving_threat(id);
     r.estimate_time_s = 10.0;
     r.estimate_mean[0] += id as f64;
     r

@@ -2,11 +2,9 @@
 //! lead's route (at start and at every `lead-route` event) and its periodic state along
 //! the route in force. Pure: it says what to send at a mission time; the mission sends it.
 
-use wingman_interfaces::{
-    LeadRoute, LeadState, MAX_ROUTE_POINTS, MAX_TARGETS, Model, Tasking, Wire,
-};
-use wingman_planner::lead::{LeadError, LeadPath, LeadPoint};
-use wingman_planner::scenario::{EventKind, FinalPoint, Scenario};
+use wingman_interfaces::{LeadRoute, LeadState, MAX_ROUTE_POINTS, MAX_TARGETS, Tasking, Wire};
+use wingman_planning::lead::{LeadError, LeadPath, LeadPoint};
+use wingman_planning::scenario::{EventKind, FinalPoint, Scenario, messages};
 
 /// A scenario whose tasking or route does not fit the messages.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -166,29 +164,8 @@ pub fn tasking(
     targets: &[[f64; 3]],
     final_point: Option<&FinalPoint>,
 ) -> Result<Tasking, DatalinkError> {
-    if targets.len() > MAX_TARGETS {
-        return Err(DatalinkError::TooManyTargets(targets.len()));
-    }
-    let mut t = Tasking::zeroed();
-    t.revision = revision;
-    t.model = sc.model.to_wire();
-    t.objective = sc.objective.to_wire();
-    t.limits = sc.vehicle;
-    t.weights = sc.weights;
-    t.start_time_s = sc.start.time_s;
-    t.start_state = sc.start.state(sc.model);
-    if let Some(f) = final_point {
-        t.final_state = f.state(sc.model);
-        t.final_time_s = f.time_s.unwrap_or(0.0);
-    }
-    t.target_count = targets.len() as u32;
-    for (slot, p) in t.targets_m.iter_mut().zip(targets) {
-        *slot = *p;
-        if sc.model == Model::TwoD {
-            slot[2] = 0.0;
-        }
-    }
-    Ok(t)
+    messages::tasking(sc, revision, targets, final_point)
+        .map_err(|e| DatalinkError::TooManyTargets(e.0))
 }
 
 fn route(

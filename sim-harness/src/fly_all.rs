@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use wingman_planner::scenario::Scenario;
+use wingman_planning::scenario::Scenario;
 
 use crate::mission::{self, FlyOptions};
 use crate::replay::{self, ReplayOutcome};
@@ -157,7 +157,7 @@ pub fn table(rows: &[Row]) -> String {
 
 /// The canonical scenarios: `dir/*.toml` in name order if `dir` exists, else the bundled
 /// ones.
-pub fn canonical(dir: &Path) -> Result<Vec<Scenario>, wingman_planner::scenario::ScenarioError> {
+pub fn canonical(dir: &Path) -> Result<Vec<Scenario>, wingman_planning::scenario::ScenarioError> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
         .map(|rd| {
             rd.filter_map(|e| e.ok().map(|e| e.path()))
@@ -167,9 +167,9 @@ pub fn canonical(dir: &Path) -> Result<Vec<Scenario>, wingman_planner::scenario:
         .unwrap_or_default();
     files.sort();
     if files.is_empty() {
-        return wingman_planner::scenario::BUNDLED
+        return wingman_planning::scenario::BUNDLED
             .iter()
-            .filter_map(|(n, _)| wingman_planner::scenario::bundled(n))
+            .filter_map(|(n, _)| wingman_planning::scenario::bundled(n))
             .collect();
     }
     files.iter().map(Scenario::load).collect()

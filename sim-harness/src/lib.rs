@@ -32,7 +32,7 @@ pub mod resume;
 pub mod sensor;
 pub mod tracker;
 
-use wingman_planner::scenario::{BUNDLED, Scenario, ScenarioError, bundled};
+use wingman_planning::scenario::{BUNDLED, Scenario, ScenarioError, bundled};
 
 /// One line per bundled scenario: name, then its summary.
 pub fn list_bundled() -> Result<Vec<(String, String)>, ScenarioError> {

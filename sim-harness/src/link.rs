@@ -1,4 +1,4 @@
-//! The harness's iceoryx2 ports to the planner, opened through `wingman_planner::service::ipc`
+//! The harness's iceoryx2 ports to the planner, opened through `wingman_ipc`
 //! (the planner's own QoS helpers, so both sides agree): publishers of every input, one
 //! header sequence counter across them, subscribers of `plan` and `status`, the
 //! `wake/planner` notifier and the `wake/harness` listener. Every message sent or taken
@@ -16,7 +16,7 @@ use wingman_interfaces::{
     Header, LeadRoute, LeadState, Message, OwnshipState, Plan, PlannerState, PlannerStatus,
     SENDER_HARNESS, Service, Tasking, ThreatReport, TrackFix, Wire,
 };
-use wingman_planner::service::ipc::{self, Ipc, IpcError};
+use wingman_ipc::{self as ipc, Ipc, IpcError};
 
 use crate::flight_log::{Direction, Entry, Kind, LogWriter};
 

@@ -7,8 +7,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use wingman_harness::clock::ClockMode;
 use wingman_harness::mission::{self, FlyOptions, PlannerMode};
-use wingman_planner::scenario::load_by_path_or_name;
-use wingman_planner::service::ServiceConfig;
+use wingman_ipc::ServiceConfig;
+use wingman_planning::scenario::load_by_path_or_name;
 
 /// Simulation harness of the wingman planner.
 #[derive(Parser)]
@@ -102,7 +102,7 @@ struct FlyArgs {
 }
 
 fn main() -> ExitCode {
-    wingman_planner::logging::init();
+    wingman_ipc::logging::init();
     iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
     match Cli::parse().command {
         Command::List => match wingman_harness::list_bundled() {

@@ -10,12 +10,12 @@ use wingman_interfaces::{
     Model, Plan, PlannerState, PlannerStatus, Quality, Service, ThreatKind, ThreatReport, Trigger,
     Wire, service_name, threat_name,
 };
-use wingman_planner::estimation::{Estimate, GaussMarkov, KalmanFilter, Road};
-use wingman_planner::problem::{Problem, ProblemError};
-use wingman_planner::scenario::Scenario;
-use wingman_planner::service::ServiceConfig;
-use wingman_planner::service::ipc;
-use wingman_planner::tracking::TrackingGains;
+use wingman_ipc as ipc;
+use wingman_ipc::ServiceConfig;
+use wingman_planning::estimation::{Estimate, GaussMarkov, KalmanFilter, Road};
+use wingman_planning::problem::{Problem, ProblemError};
+use wingman_planning::scenario::Scenario;
+use wingman_planning::tracking::TrackingGains;
 
 use crate::clock::{ClockMode, Pacer, Periodic, step_time};
 use crate::datalink::{Datalink, DatalinkError};
@@ -180,9 +180,9 @@ pub enum FlyError {
     #[error("sensor: {0}")]
     Sensor(#[from] SensorError),
     #[error("vehicle: {0}")]
-    Vehicle(#[from] wingman_planner::dynamics::DynamicsError),
+    Vehicle(#[from] wingman_planning::dynamics::DynamicsError),
     #[error("planner configuration: {0}")]
-    Config(#[from] wingman_planner::service::config::ConfigError),
+    Config(#[from] wingman_ipc::config::ConfigError),
     #[error("planner process: {0}")]
     Process(#[from] ProcessError),
     #[error("{0}")]

@@ -12,9 +12,9 @@ use std::path::Path;
 
 use plotters::prelude::*;
 use wingman_interfaces::{Model, Objective, Trigger};
-use wingman_planner::estimation::{GaussMarkov, MovingThreat, Road};
-use wingman_planner::plot::{self, MapMarker, MapPath, MapPlot, Stroke};
-use wingman_planner::problem::Problem;
+use wingman_planning::estimation::{GaussMarkov, MovingThreat, Road};
+use wingman_planning::problem::Problem;
+use wingman_plot::{self as plot, MapMarker, MapPath, MapPlot, Stroke};
 
 use crate::mission::Flight;
 use crate::report::{Report, exposure_series};
@@ -259,7 +259,7 @@ pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
 
 /// Footprint of the keep-out region a snapshot's estimate gives at its time.
 fn keep_out(
-    m: &wingman_planner::scenario::MovingThreatSpec,
+    m: &wingman_planning::scenario::MovingThreatSpec,
     e: &crate::mission::EstimateSnapshot,
 ) -> PlotResult<Vec<[f64; 2]>> {
     let road: Vec<[f64; 2]> = m.road_m.iter().map(|p| [p[0], p[1]]).collect();

@@ -1,8 +1,7 @@
-//! `replay`: a flown `flight.log` fed back to the planner, in-process. The planner service
-//! (`wingman_planner::service::run`, the very code `wingman-planner serve` runs) starts on
-//! a thread with the logged configuration on a fresh vehicle id; the logged inputs are
-//! published as they were (headers included) and, at every logged lock-step barrier, the
-//! replay waits as the flight did until the planner has processed them and is idle. Every
+//! `replay`: a flown `flight.log` fed back to the planner. `wingman-planner serve` (found
+//! as `fly` finds it) starts with the logged configuration on a fresh vehicle id; the
+//! logged inputs are published as they were (headers included) and, at every logged
+//! lock-step barrier, the replay waits as the flight did until the planner has processed them and is idle. Every
 //! plan that comes out is compared with the logged one **byte for byte**, except
 //! `compute_ms` (a wall-clock measurement): same inputs and seed, same plan.
 //!
@@ -14,17 +13,16 @@
 //! planner saw them in flight, and says so.
 
 use std::mem::offset_of;
-use std::path::Path;
-use std::thread::JoinHandle;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use wingman_interfaces::{Plan, Wire};
-use wingman_planner::clock::MonotonicClock;
-use wingman_planner::service::{RunOptions, ServiceConfig, Shutdown};
+use wingman_ipc::ServiceConfig;
 
 use crate::flight_log::{self, Direction, Entry, LogWriter};
 use crate::link::PlannerLink;
 use crate::mission::unique_vehicle_id;
+use crate::process::{PlannerProcess, ProcessError, planner_binary};
 
 /// A replay that could not run.
 #[derive(Debug, thiserror::Error)]
@@ -32,11 +30,13 @@ pub enum ReplayError {
     #[error("{0}")]
     Log(#[from] flight_log::LogError),
     #[error("the logged planner configuration: {0}")]
-    Config(#[from] wingman_planner::service::config::ConfigError),
+    Config(#[from] wingman_ipc::config::ConfigError),
     #[error("{0}")]
     Link(#[from] crate::link::LinkError),
     #[error("the planner service: {0}")]
     Service(String),
+    #[error("{0}")]
+    Process(#[from] ProcessError),
     #[error(
         "a resumed flight's log (taken over at mission time {mission_s:.1} s from a planner on plan {plan_id}): \
          the planner's world before the resume is not in it, so its plans cannot be replayed"
@@ -121,58 +121,49 @@ impl std::fmt::Display for ReplayOutcome {
     }
 }
 
-/// The service on a thread of this process; stopped in `Drop`.
-struct InProcessPlanner {
-    shutdown: Shutdown,
-    thread: Option<JoinHandle<Result<(), String>>>,
+/// `wingman-planner serve` started for a replay, with its configuration and log in a
+/// folder of its own that goes with it.
+struct ReplayPlanner {
+    process: PlannerProcess,
+    dir: PathBuf,
 }
 
-impl InProcessPlanner {
-    fn start(config: ServiceConfig) -> Result<InProcessPlanner, ReplayError> {
-        let shutdown = Shutdown::new();
-        let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
-        let options = RunOptions {
-            config,
-            clock,
-            handle_signals: false,
-            shutdown: shutdown.clone(),
-        };
-        let thread = std::thread::Builder::new()
-            .name("planner-service".into())
-            .spawn(move || {
-                wingman_planner::service::run(options)
-                    .map(|_| ())
-                    .map_err(|e| e.to_string())
-            })
-            .map_err(|e| ReplayError::Service(e.to_string()))?;
-        Ok(InProcessPlanner {
-            shutdown,
-            thread: Some(thread),
-        })
+impl ReplayPlanner {
+    fn start(config: &ServiceConfig) -> Result<ReplayPlanner, ReplayError> {
+        let dir = std::env::temp_dir().join(format!("wingman-{}", config.vehicle_id));
+        let io = |e: std::io::Error| ReplayError::Service(format!("{}: {e}", dir.display()));
+        std::fs::create_dir_all(&dir).map_err(io)?;
+        let config_path = dir.join("planner.toml");
+        std::fs::write(&config_path, config.to_toml()).map_err(io)?;
+        let process = PlannerProcess::spawn(
+            &planner_binary()?,
+            &config_path,
+            &config.vehicle_id,
+            &dir.join("planner.log"),
+        )?;
+        Ok(ReplayPlanner { process, dir })
     }
 
-    fn is_running(&self) -> bool {
-        self.thread.as_ref().is_some_and(|t| !t.is_finished())
+    fn is_running(&mut self) -> bool {
+        self.process.is_running()
     }
 
-    fn stop(&mut self, link: &PlannerLink) -> Result<(), ReplayError> {
-        self.shutdown.request();
-        let _ = link.wake();
-        match self.thread.take().map(JoinHandle::join) {
-            Some(Ok(Err(e))) => Err(ReplayError::Service(e)),
-            Some(Err(_)) => Err(ReplayError::Service("the service thread panicked".into())),
-            _ => Ok(()),
+    /// Stops the planner (SIGTERM: it finishes its plan and exits 0).
+    fn stop(&mut self) -> Result<(), ReplayError> {
+        match self.process.stop(Duration::from_secs(10)) {
+            Some(status) if status.success() => Ok(()),
+            other => Err(ReplayError::Service(format!(
+                "the planner did not stop cleanly ({other:?}); its log: {}",
+                std::fs::read_to_string(self.dir.join("planner.log")).unwrap_or_default()
+            ))),
         }
     }
 }
 
-impl Drop for InProcessPlanner {
+impl Drop for ReplayPlanner {
     fn drop(&mut self) {
-        if let Some(t) = self.thread.take() {
-            self.shutdown.request();
-            // The heartbeat wakes the loop at the latest.
-            let _ = t.join();
-        }
+        self.process.kill();
+        let _ = std::fs::remove_dir_all(&self.dir);
     }
 }
 
@@ -227,7 +218,7 @@ pub fn replay(log: &Path, timeout: Duration) -> Result<ReplayOutcome, ReplayErro
     let logged: Vec<Box<Plan>> = flight_log::plans(&entries).collect();
 
     let mut link = PlannerLink::open(&config.vehicle_id, LogWriter::discard())?;
-    let mut planner = InProcessPlanner::start(config)?;
+    let mut planner = ReplayPlanner::start(&config)?;
     let mut replayed: Vec<Box<Plan>> = Vec::new();
     let up = std::time::Instant::now();
     while link.status().is_none() {
@@ -241,7 +232,7 @@ pub fn replay(log: &Path, timeout: Duration) -> Result<ReplayOutcome, ReplayErro
     let mut group_time: Option<f64> = None;
     let barrier = |link: &mut PlannerLink,
                    replayed: &mut Vec<Box<Plan>>,
-                   planner: &InProcessPlanner|
+                   planner: &mut ReplayPlanner|
      -> Result<(), ReplayError> {
         link.wake()?;
         let (r, ok) = link.sync(timeout, || planner.is_running())?;
@@ -265,7 +256,7 @@ pub fn replay(log: &Path, timeout: Duration) -> Result<ReplayOutcome, ReplayErro
             } => {
                 if !lock_step {
                     if group_time.is_some_and(|t| t != *mission_s) {
-                        barrier(&mut link, &mut replayed, &planner)?;
+                        barrier(&mut link, &mut replayed, &mut planner)?;
                     }
                     group_time = Some(*mission_s);
                 }
@@ -273,12 +264,12 @@ pub fn replay(log: &Path, timeout: Duration) -> Result<ReplayOutcome, ReplayErro
                     inputs += 1;
                 }
             }
-            Entry::Sync { .. } => barrier(&mut link, &mut replayed, &planner)?,
+            Entry::Sync { .. } => barrier(&mut link, &mut replayed, &mut planner)?,
             _ => {}
         }
     }
-    barrier(&mut link, &mut replayed, &planner)?;
-    planner.stop(&link)?;
+    barrier(&mut link, &mut replayed, &mut planner)?;
+    planner.stop()?;
 
     let mut identical = 0;
     let mut mismatches = Vec::new();

@@ -5,8 +5,8 @@
 
 use serde::Serialize;
 use wingman_interfaces::{Model, Objective, Quality, Trigger};
-use wingman_planner::metrics::{TargetMiss, simpson, target_misses};
-use wingman_planner::threat::{ExposureAcc, Superquadric, ThreatError, ThreatLayout};
+use wingman_planning::metrics::{TargetMiss, simpson, target_misses};
+use wingman_planning::threat::{ExposureAcc, Superquadric, ThreatError, ThreatLayout};
 
 use crate::mission::{EndReason, Flight, position};
 

@@ -29,7 +29,7 @@
 use std::time::Duration;
 
 use wingman_interfaces::{LeadRoute, Objective, Plan, PlannerStatus, Tasking};
-use wingman_planner::scenario::Scenario;
+use wingman_planning::scenario::Scenario;
 
 use crate::clock::step_time;
 use crate::datalink::Datalink;

@@ -9,8 +9,8 @@ use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use wingman_interfaces::{MAX_ROAD_POINTS, ThreatKind, ThreatReport, TrackFix, Wire, threat_name};
-use wingman_planner::estimation::{Estimate, EstimationError, GaussMarkov, Road};
-use wingman_planner::scenario::{MovingThreatSpec, Scenario, StaticThreatSpec};
+use wingman_planning::estimation::{Estimate, EstimationError, GaussMarkov, Road};
+use wingman_planning::scenario::{MovingThreatSpec, Scenario, StaticThreatSpec};
 
 /// A scenario's threat that the sensor cannot emulate.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -249,15 +249,7 @@ impl ThreatSensor {
 }
 
 fn static_report(id: u32, s: &StaticThreatSpec) -> ThreatReport {
-    let mut r = ThreatReport::zeroed();
-    r.threat_id = id;
-    r.kind = ThreatKind::Static.to_wire();
-    r.name = threat_name(&s.name);
-    r.center_m = s.center_m;
-    r.axes_m = s.axes_m;
-    r.exponents = s.exponents;
-    r.yaw_rad = s.yaw_rad;
-    r
+    wingman_planning::scenario::messages::static_threat_report(id, s)
 }
 
 fn moving_report(id: u32, m: &MovingThreatSpec, est: &Estimate) -> ThreatReport {

@@ -1,17 +1,17 @@
 //! The inner-loop tracker: flies the newest plan whose start time has come (and which the
 //! harness has received — in the lock-step clock, from `created_at + compute` on) with the
-//! vehicle model (RK4) and the tracking law of `wingman_planner::tracking` (the plan's
+//! vehicle model (RK4) and the tracking law of `wingman_planning::tracking` (the plan's
 //! controls as feed-forward plus feedback on position and heading error), reports
 //! `OwnshipState` with its deviation from the plan, and flies a safe hold — a level turn —
 //! when the plan it flies is past its `valid_until` with no successor received (or it has
 //! no plan), logging each hold.
 
 use wingman_interfaces::{Model, OWNSHIP_HOLDING, OwnshipState, Plan, Wire};
-use wingman_planner::dynamics::{
+use wingman_planning::dynamics::{
     DynamicsError, G0, Planar, Spatial, VehicleLimits, rk4_step_with, wrap_angle,
 };
-use wingman_planner::problem::Problem;
-use wingman_planner::tracking::{Deviation, Tracker, TrackingGains};
+use wingman_planning::problem::Problem;
+use wingman_planning::tracking::{Deviation, Tracker, TrackingGains};
 
 /// Longest integration step, s.
 pub const MAX_SUBSTEP_S: f64 = 0.05;

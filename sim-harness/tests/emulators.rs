@@ -10,12 +10,12 @@ use wingman_harness::tracker::{InnerLoop, ReceivedPlan};
 use wingman_interfaces::{
     Header, Model, OWNSHIP_HOLDING, Plan, Quality, SENDER_PLANNER, Trigger, Wire,
 };
-use wingman_planner::dynamics::{Planar, rk4_step_with};
-use wingman_planner::problem::Problem;
-use wingman_planner::scenario::{Scenario, bundled};
-use wingman_planner::service::export::{PlanInfo, set_next_replan, write_plan};
-use wingman_planner::tracking::TrackingGains;
-use wingman_planner::trajectory::Trajectory;
+use wingman_planning::dynamics::{Planar, rk4_step_with};
+use wingman_planning::plan_message::{PlanInfo, set_next_replan, write_plan};
+use wingman_planning::problem::Problem;
+use wingman_planning::scenario::{Scenario, bundled};
+use wingman_planning::tracking::TrackingGains;
+use wingman_planning::trajectory::Trajectory;
 
 fn scenario(name: &str) -> Scenario {
     bundled(name).expect("bundled").expect("valid")
@@ -129,7 +129,7 @@ fn the_tracker_switches_at_start_and_availability_and_holds_without_a_successor(
     tl.advance_to(40.0);
     assert_eq!(tl.sample().plan_id, 1);
     // A successor that starts at 45 s but is only available from 48 s.
-    let at = wingman_planner::service::export::state_at(&tl.plans()[0].plan, 45.0).unwrap();
+    let at = wingman_planning::plan_message::state_at(&tl.plans()[0].plan, 45.0).unwrap();
     let second = planar_plan(&problem, 2, 45.0, [at[0], at[1], at[2]], 300.0);
     tl.receive(received(second.clone(), 48.0));
     tl.advance_to(47.0);

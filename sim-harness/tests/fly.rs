@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-use wingman_tests::binary;
+use wingman_testkit::binary;
 
 const LIMIT: Duration = Duration::from_secs(600);
 

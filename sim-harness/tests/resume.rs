@@ -17,11 +17,11 @@ use wingman_harness::tracker::{InnerLoop, ReceivedPlan, reference};
 use wingman_interfaces::{
     Header, Model, Plan, PlannerStatus, Quality, SENDER_PLANNER, ThreatKind, Trigger, Wire,
 };
-use wingman_planner::problem::Problem;
-use wingman_planner::scenario::{Scenario, bundled};
-use wingman_planner::service::export::{PlanInfo, write_plan};
-use wingman_planner::tracking::TrackingGains;
-use wingman_planner::trajectory::Trajectory;
+use wingman_planning::plan_message::{PlanInfo, write_plan};
+use wingman_planning::problem::Problem;
+use wingman_planning::scenario::{Scenario, bundled};
+use wingman_planning::tracking::TrackingGains;
+use wingman_planning::trajectory::Trajectory;
 
 fn scenario(name: &str) -> Scenario {
     bundled(name).expect("bundled").expect("valid")

@@ -19,7 +19,7 @@
 //!   `--echo`) wakes on its listener (a timed wait, no spinning, like the planner's
 //!   WaitSet), copies the sample into a loaned one on a second service and notifies back;
 //!   the time is from before the publication to the echo's receipt. Every port comes from
-//!   `wingman_planner::service::ipc`, so QoS and wake-ups are the real system's.
+//!   `wingman_ipc`, so QoS and wake-ups are the real system's.
 //! - `service_round_trip`: a real `wingman-planner serve` flying the first plan of
 //!   `2d-min-time-avoidable` gets an `OwnshipState` and wakes; the time is until the
 //!   `PlannerStatus` echoing its sequence is received.
@@ -34,9 +34,6 @@
 //! run uses vehicle ids of its own (`bl<pid>...`); every child is killed on drop and the
 //! iceoryx2 resources of dead nodes are removed.
 
-#[path = "../../planner-service/tests/service_support/mod.rs"]
-mod service_support;
-
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -49,13 +46,16 @@ use iceoryx2::port::notifier::Notifier;
 use iceoryx2::port::publisher::Publisher;
 use iceoryx2::port::subscriber::Subscriber;
 use serde_json::{Value, json};
-use service_support::{FakeHarness, ownship_2d, scenario_threats, static_threat, tasking_from};
 use wingman_interfaces::*;
-use wingman_planner::scenario::bundled;
-use wingman_planner::service::export::state_at;
-use wingman_planner::service::ipc::{self, Ipc};
+use wingman_ipc::{self as ipc, Ipc};
 use wingman_planner::service::sched;
-use wingman_tests::process::{Proc, TempDir, planner};
+use wingman_planning::plan_message::state_at;
+use wingman_planning::scenario::bundled;
+use wingman_planning::scenario::messages::{
+    take_off_tasking as tasking_from, take_off_threat_reports as scenario_threats,
+};
+use wingman_testkit::fake_harness::{FakeHarness, ownship_2d, static_threat};
+use wingman_testkit::process::{Proc, TempDir, planner};
 
 /// Cores both processes (and the hog) run on.
 const CORES: &str = "0,1";
@@ -107,7 +107,7 @@ impl Options {
     /// The message threads' scheduler slice, µs (0: the kernel's default).
     fn slice_us(&self) -> u64 {
         self.message_slice_us.unwrap_or(
-            wingman_planner::service::ServiceConfig::default()
+            wingman_ipc::ServiceConfig::default()
                 .scheduling
                 .message_slice_us,
         )
@@ -277,7 +277,7 @@ fn run(o: &Options) {
         if busy.is_empty() { "none" } else { &busy }
     );
     // Build (once) the planner binary before anything is timed.
-    let planner_bin = wingman_tests::binary("wingman-planner");
+    let planner_bin = wingman_testkit::binary("wingman-planner");
     println!("planner: {}", planner_bin.display());
     let mut results: BTreeMap<(&str, &str), Series> = BTreeMap::new();
     for (c, cond) in CONDITIONS.iter().enumerate() {

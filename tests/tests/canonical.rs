@@ -8,11 +8,11 @@
 
 use std::time::Duration;
 
+use wingman_testkit::process::{TempDir, harness, report, text};
+use wingman_testkit::scenarios_dir;
 use wingman_tests::outcome::{
     assert_every_tr_followed, assert_mission_succeeded, assert_replan_popups,
 };
-use wingman_tests::process::{TempDir, harness, report, text};
-use wingman_tests::scenarios_dir;
 
 #[test]
 fn every_canonical_scenario_flies_to_a_successful_end() {

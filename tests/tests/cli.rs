@@ -1,7 +1,7 @@
 //! The binaries as a user runs them: separate processes, real files, exit codes.
 
 use std::process::Command;
-use wingman_tests::{binary, scenarios_dir};
+use wingman_testkit::{binary, scenarios_dir};
 
 #[test]
 fn harness_lists_every_bundled_scenario() {

@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use wingman_harness::flight_log::{self, Direction, Entry, Kind};
 use wingman_interfaces::Wire;
-use wingman_tests::process::{TempDir, harness, text, vehicle};
+use wingman_testkit::process::{TempDir, harness, text, vehicle};
 
 /// The plans of a flight log as wire bytes, `compute_ms` zeroed.
 fn plans(log: &Path) -> Vec<Vec<u8>> {

@@ -4,24 +4,24 @@
 //! removed). Each test's doc names the protection it exercises: without it, the test
 //! fails.
 
-#[path = "../../planner-service/tests/service_support/mod.rs"]
-mod service_support;
-
 use std::time::Duration;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use service_support::{FakeHarness, scenario_threats, static_threat, tasking_from};
 use wingman_harness::flight_log::{self, Direction, Kind};
 use wingman_harness::tracker::reference;
 use wingman_interfaces::*;
-use wingman_planner::scenario::bundled;
-use wingman_planner::service::ipc::{self, Ipc};
-use wingman_tests::outcome::{assert_every_tr_followed, assert_mission_succeeded, plans};
-use wingman_tests::process::{
+use wingman_ipc::{self as ipc, Ipc};
+use wingman_planning::scenario::bundled;
+use wingman_planning::scenario::messages::{
+    take_off_tasking as tasking_from, take_off_threat_reports as scenario_threats,
+};
+use wingman_testkit::fake_harness::{FakeHarness, static_threat};
+use wingman_testkit::process::{
     Proc, TempDir, harness, harness_logging, planner, planner_config, report, text, vehicle,
 };
-use wingman_tests::rogue::{Rogue, send_invalid};
+use wingman_testkit::rogue::{Rogue, send_invalid};
+use wingman_tests::outcome::{assert_every_tr_followed, assert_mission_succeeded, plans};
 
 const FLIGHT: Duration = Duration::from_secs(900);
 const WAIT: Duration = Duration::from_secs(120);
@@ -31,7 +31,7 @@ const WAIT: Duration = Duration::from_secs(120);
 /// the buffer's overflow unread.
 fn send_batches<M: Message + 'static>(
     h: &mut FakeHarness,
-    p: &mut wingman_tests::process::Proc,
+    p: &mut wingman_testkit::process::Proc,
     port: &iceoryx2::port::publisher::Publisher<Ipc, M, ()>,
     msgs: &[M],
 ) {
@@ -95,12 +95,13 @@ fn planner_with_first_plan(
     dir: &TempDir,
     tag: &str,
     extra: &str,
-) -> (wingman_tests::process::Proc, FakeHarness, String) {
+) -> (wingman_testkit::process::Proc, FakeHarness, String) {
     let v = vehicle(tag);
     let cfg = planner_config(dir.path(), 2000, 6000, extra);
     let p = planner(&cfg, &v, &dir.path().join("planner.log"));
     let mut h = FakeHarness::new(&v);
-    h.first_plan_of("2d-min-time-avoidable", WAIT);
+    let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();
+    h.first_plan(&scenario_threats(&sc), tasking_from(&sc, 1), WAIT);
     (p, h, v)
 }
 
@@ -263,7 +264,7 @@ fn a_deadline_too_short_to_converge_still_gives_a_flagged_plan_in_time() {
     assert!(first.validate().is_ok());
 
     // A pop-up on the plan ahead: a re-plan under the same deadline.
-    let on = wingman_planner::service::export::state_at(first, 200.0).unwrap();
+    let on = wingman_planning::plan_message::state_at(first, 200.0).unwrap();
     h.set_time(10.0);
     h.send_threat(static_threat(
         90,
@@ -350,7 +351,7 @@ fn a_planner_killed_mid_flight_is_replaced_and_the_mission_completes() {
 /// Starts a planner and a harness flying `2d-min-time-avoidable` against it in the real
 /// -time clock, and kills the harness (`kill -9`) once the flight is under way. Returns
 /// the planner, the status watcher and the folder.
-fn kill_the_harness(dir: &TempDir, v: &str) -> (wingman_tests::process::Proc, FakeStatus) {
+fn kill_the_harness(dir: &TempDir, v: &str) -> (wingman_testkit::process::Proc, FakeStatus) {
     let cfg = planner_config(dir.path(), 2000, 6000, "\n[staleness]\nownship_ms = 500\n");
     let p = planner(&cfg, v, &dir.path().join("planner.log"));
     let first = dir.path().join("first");

@@ -5,18 +5,20 @@
 //! plan, or let a non-finite number through (every plan and status stays valid). The
 //! message types' own `validate()` is fuzzed in `interfaces/tests/validate.rs`.
 
-#[path = "../../planner-service/tests/service_support/mod.rs"]
-mod service_support;
-
 use std::cell::RefCell;
 use std::time::Duration;
 
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
-use service_support::*;
 use wingman_interfaces::*;
-use wingman_planner::scenario::bundled;
-use wingman_tests::rogue::{Rogue, send_invalid};
+use wingman_planner::service::ServiceThread;
+use wingman_planning::scenario::bundled;
+use wingman_planning::scenario::messages::{
+    take_off_tasking as tasking_from, take_off_threat_reports as scenario_threats,
+};
+use wingman_testkit::fake_harness::*;
+use wingman_testkit::process::vehicle;
+use wingman_testkit::rogue::{Rogue, send_invalid};
 
 const WAIT: Duration = Duration::from_secs(120);
 
@@ -99,9 +101,10 @@ fn send(r: &Rogue, service: usize, bytes: &[u8], word: Option<usize>) -> bool {
 #[test]
 fn arbitrary_messages_to_a_running_service_are_rejected_without_effect() {
     let v = vehicle("fuzz");
-    let service = ServiceThread::start(test_config(&v));
+    let service = ServiceThread::start(test_config(&v)).expect("start the service");
     let mut h = FakeHarness::new(&v);
-    h.first_plan_of("2d-min-time-avoidable", WAIT);
+    let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();
+    h.first_plan(&scenario_threats(&sc), tasking_from(&sc, 1), WAIT);
     let before = h.last_status();
     let rogue = Rogue::new(&v);
     let sent = RefCell::new(0u64);
@@ -146,7 +149,7 @@ fn arbitrary_messages_to_a_running_service_are_rejected_without_effect() {
     let s = h.last_status();
     assert_eq!(s.current_plan_id, before.current_plan_id);
     drop(rogue);
-    let summary = service.stop(&h);
+    let summary = service.stop(|| h.wake()).expect("the service stops");
     assert_eq!(
         summary.status.messages_rejected - before.messages_rejected,
         n

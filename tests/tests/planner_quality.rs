@@ -6,11 +6,11 @@
 //! the path stays outside every static threat (min F ≥ 1).
 
 use std::path::PathBuf;
-use wingman_planner::clock::MonotonicClock;
 use wingman_planner::offline::{PlanRequest, plan_scenario};
-use wingman_planner::scenario::{BUNDLED, bundled};
-use wingman_tests::judge::{evaluate, reference_cost};
-use wingman_tests::scenarios_dir;
+use wingman_planning::clock::MonotonicClock;
+use wingman_planning::scenario::{BUNDLED, bundled};
+use wingman_testkit::judge::{evaluate, reference_cost};
+use wingman_testkit::scenarios_dir;
 
 fn number(v: &serde_json::Value, key: &str) -> f64 {
     v[key].as_f64().unwrap_or(f64::INFINITY)

@@ -4,11 +4,11 @@
 //! target within 50 m, bounds held, never inside a static threat (min F ≥ 1), and no
 //! planner failure or non-finite number.
 
-use wingman_planner::clock::MonotonicClock;
 use wingman_planner::offline::{PlanRequest, plan_scenario};
-use wingman_planner::scenario::Scenario;
-use wingman_tests::judge::evaluate;
-use wingman_tests::random_scenario::random_scenario;
+use wingman_planning::clock::MonotonicClock;
+use wingman_planning::scenario::Scenario;
+use wingman_testkit::judge::evaluate;
+use wingman_testkit::random_scenario::random_scenario;
 
 const FAMILY_SEED: u64 = 20261123;
 

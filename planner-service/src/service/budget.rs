@@ -14,7 +14,7 @@
 
 use std::time::Duration;
 
-use super::config::DUTY_HISTORY;
+use wingman_ipc::config::DUTY_HISTORY;
 
 /// Limits of the gate.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -50,19 +50,19 @@ use wingman_interfaces::{
 };
 
 use super::budget::{ComputeGate, GateSettings};
-use super::config::{ConfigError, ServiceConfig};
-use super::export::{self, PlanInfo, PlanPoints};
-use super::ipc::{self, Ipc, IpcError};
 use super::sched::{self, SliceOutcome};
 use super::solver::{SolveRequest, SolveResult, Solver, SolverStartError, Ticket};
 use super::triggers::{
     self, DeviationBounds, PlanWindow, PopupAssessment, RouteDecision, TaskingDecision, TriggerSet,
 };
 use super::world::{FixOutcome, Input, Splice, ThreatChange, ThreatSlot, World};
-use crate::clock::Clock;
-use crate::dynamics::{VehicleLimits, idx3};
-use crate::hybrid::{PlanOutcome, PlannerSettings};
-use crate::problem::Problem;
+use wingman_ipc::config::{ConfigError, ServiceConfig};
+use wingman_ipc::{self as ipc, Ipc, IpcError};
+use wingman_planning::clock::Clock;
+use wingman_planning::dynamics::{VehicleLimits, idx3};
+use wingman_planning::hybrid::{PlanOutcome, PlannerSettings};
+use wingman_planning::plan_message::{self as export, PlanInfo, PlanPoints};
+use wingman_planning::problem::Problem;
 
 /// Largest plan id (exclusive) a restarted planner continues from: far above any real
 /// mission's count, far below `u64::MAX`, so plan ids never wrap to 0 ("no plan").

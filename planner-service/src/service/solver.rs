@@ -16,9 +16,9 @@ use crossbeam::channel::{self, Receiver, RecvTimeoutError, Sender};
 use tracing::{error, info, info_span};
 use wingman_interfaces::Trigger;
 
-use crate::clock::{Clock, Deadline};
-use crate::hybrid::{PlanError, PlanOutcome, Planner, PlannerSettings};
-use crate::problem::Problem;
+use wingman_planning::clock::{Clock, Deadline};
+use wingman_planning::hybrid::{PlanError, PlanOutcome, Planner, PlannerSettings};
+use wingman_planning::problem::Problem;
 
 /// What travels with a problem to the solver and back.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -19,9 +19,9 @@
 
 use wingman_interfaces::{LeadRoute, OwnshipState, Tasking, Trigger};
 
-use crate::estimation::MovingThreat;
-use crate::replan::{self, PlanPoint, PopupHit, ReplanTime};
-use crate::threat::Superquadric;
+use wingman_planning::estimation::MovingThreat;
+use wingman_planning::replan::{self, PlanPoint, PopupHit, ReplanTime};
+use wingman_planning::threat::Superquadric;
 
 /// What a received tasking means.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -14,13 +14,15 @@ use wingman_interfaces::{
     TrackFix, ValidationError, Wire,
 };
 
-use super::config::StalenessConfig;
 use super::triggers::{self, RouteDecision, TaskingDecision};
-use crate::dynamics::{DynamicsError, VehicleLimits};
-use crate::estimation::{Estimate, EstimationError, GaussMarkov, KalmanFilter, MovingThreat, Road};
-use crate::lead::{LeadError, LeadPath};
-use crate::problem::{CostWeights, Problem, Threats};
-use crate::threat::{MAX_THREATS, Superquadric, ThreatError, ThreatLayout};
+use wingman_ipc::config::StalenessConfig;
+use wingman_planning::dynamics::{DynamicsError, VehicleLimits};
+use wingman_planning::estimation::{
+    Estimate, EstimationError, GaussMarkov, KalmanFilter, MovingThreat, Road,
+};
+use wingman_planning::lead::{LeadError, LeadPath};
+use wingman_planning::problem::{CostWeights, Problem, Threats};
+use wingman_planning::threat::{MAX_THREATS, Superquadric, ThreatError, ThreatLayout};
 
 /// Static threats the world holds (the planner's layout capacity).
 pub const MAX_STATIC_THREATS: usize = MAX_THREATS;
@@ -483,7 +485,7 @@ impl World {
         let (Some(model), Some(objective)) = (t.model(), t.objective()) else {
             return Err(BuildError::NoTasking);
         };
-        out.limits = crate::problem::vehicle_limits(model, &t.limits)?;
+        out.limits = wingman_planning::problem::vehicle_limits(model, &t.limits)?;
         out.model = model;
         out.objective = objective;
         out.weights = CostWeights {

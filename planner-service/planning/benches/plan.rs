@@ -1,0 +1,285 @@
+//! Planner benchmark (issue 5): for every canonical scenario, the take-off plan with 20
+//! swarm seeds — median and p95 of the plan time, the share of swarm, NLP and the rest,
+//! the cost spread across seeds, peak heap — and how far past a too-short deadline the
+//! planner returns. Prints a Markdown table (run with `cargo bench -p wingman-planner
+//! --bench plan`; `-- --runs N`, `-- --only NAME` to narrow it, `-- --sequential`).
+//!
+//! The peak heap is counted in a pass of its own (the same plans again), not in the
+//! timed runs: the counting allocator's shared counters, updated by both threads at
+//! every allocation of the solver, cost the timed plans up to 15 %.
+//!
+//! The scenarios are interleaved: round `k` plans every scenario with seed `k`, so that
+//! each scenario's runs spread over the whole bench (`-- --sequential`: each scenario's
+//! runs in a row). A fixed workload (`host_reference_ms`) is timed before every round and
+//! at the end: the host's speed while the plans ran.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicBool, AtomicIsize, Ordering};
+use std::time::Duration;
+
+use wingman_planning::clock::{Clock, Deadline, MonotonicClock};
+use wingman_planning::hybrid::{Planner, PlannerSettings};
+use wingman_planning::problem::Problem;
+use wingman_planning::scenario::{BUNDLED, bundled};
+
+/// The system allocator, counting the bytes live and their peak while `COUNTING` is set.
+/// Bytes freed while counting that were allocated before are subtracted too: the counted
+/// pass creates its planner inside it, so the count is the plan's own.
+struct Peak;
+static COUNTING: AtomicBool = AtomicBool::new(false);
+static LIVE: AtomicIsize = AtomicIsize::new(0);
+static PEAK: AtomicIsize = AtomicIsize::new(0);
+
+unsafe impl GlobalAlloc for Peak {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if COUNTING.load(Ordering::Relaxed) {
+            let size = layout.size() as isize;
+            let now = LIVE.fetch_add(size, Ordering::Relaxed) + size;
+            PEAK.fetch_max(now, Ordering::Relaxed);
+        }
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        if COUNTING.load(Ordering::Relaxed) {
+            LIVE.fetch_sub(layout.size() as isize, Ordering::Relaxed);
+        }
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+/// The peak heap of `run` above what was live when it began, in bytes.
+fn peak_of(run: impl FnOnce()) -> isize {
+    LIVE.store(0, Ordering::Relaxed);
+    PEAK.store(0, Ordering::Relaxed);
+    COUNTING.store(true, Ordering::SeqCst);
+    run();
+    COUNTING.store(false, Ordering::SeqCst);
+    PEAK.load(Ordering::Relaxed)
+}
+
+mod common;
+use common::kkt_block;
+
+#[global_allocator]
+static GLOBAL: Peak = Peak;
+
+/// The host's speed now: a fixed workload (400 dense Bunch–Kaufman factorisations of one
+/// 72 × 72 KKT-shaped block, the planner's hottest kernel) run on two threads at once, as
+/// the planner runs; the slower thread's median of three timings, in ms. Timed before
+/// every round of plans, so that their times can be read against the speed the host had
+/// while they ran (a shared VM's speed swings by up to 1.8× within minutes;
+/// docs/BENCHMARKS.md).
+fn host_reference_ms() -> f64 {
+    std::thread::scope(|s| {
+        let other = s.spawn(reference_workload_ms);
+        let here = reference_workload_ms();
+        here.max(other.join().expect("the reference workload does not panic"))
+    })
+}
+
+/// One thread's part of [`host_reference_ms`]: the block of the kkt bench's `n = 72`
+/// case (42 primal and 30 dual rows).
+fn reference_workload_ms() -> f64 {
+    use wingman_planning::collocation::bunch_kaufman as bk;
+    const N: usize = 72;
+    let k = kkt_block(42, 30, N as u64);
+    let mut a = k.clone();
+    let mut piv = vec![0i32; N];
+    let mut work = vec![0.0; bk::work_len(N)];
+    let mut times: Vec<f64> = (0..3)
+        .map(|_| {
+            let began = std::time::Instant::now();
+            for _ in 0..400 {
+                a.copy_from_slice(&k);
+                std::hint::black_box(bk::factor(&mut a, N, &mut piv, &mut work))
+                    .expect("the reference block is nonsingular");
+            }
+            began.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[1]
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    let k = ((sorted.len() as f64 - 1.0) * p).round() as usize;
+    sorted[k.min(sorted.len() - 1)]
+}
+
+/// One scenario's timed plans.
+#[derive(Default)]
+struct Tally {
+    times: Vec<f64>,
+    swarm: f64,
+    nlp: f64,
+    ranking: f64,
+    total: f64,
+    costs: Vec<f64>,
+    qualities: std::collections::BTreeMap<String, usize>,
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let runs: u64 = args
+        .iter()
+        .position(|a| a == "--runs")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(20);
+    let only = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1))
+        .cloned();
+    let sequential = args.iter().any(|a| a == "--sequential");
+    let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
+    let settings = PlannerSettings::default();
+    let scenarios: Vec<(&str, Problem)> = BUNDLED
+        .iter()
+        .filter(|(name, _)| only.as_ref().is_none_or(|o| name.contains(o.as_str())))
+        .map(|(name, _)| {
+            let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+            (*name, problem)
+        })
+        .collect();
+    let settings_of = |seed: u64| PlannerSettings {
+        swarm: settings.swarm.clone().with_seed(seed),
+        ..settings.clone()
+    };
+    // One take-off plan with a fresh planner and swarm seed `seed`.
+    let plan_once = |problem: &Problem, seed: u64| {
+        let s = settings_of(seed);
+        Planner::new(&s)
+            .plan(problem, &s, Deadline::after(clock, Duration::from_secs(30)))
+            .unwrap()
+    };
+    let plan = |problem: &Problem, seed: u64, tally: &mut Tally| {
+        let out = plan_once(problem, seed);
+        let t = out.times.total.as_secs_f64() * 1e3;
+        tally.times.push(t);
+        tally.swarm += out.times.swarm.as_secs_f64() * 1e3;
+        tally.nlp += out.times.nlp.as_secs_f64() * 1e3;
+        tally.ranking += out.times.ranking.as_secs_f64() * 1e3;
+        tally.total += t;
+        tally.costs.push(out.cost);
+        *tally
+            .qualities
+            .entry(format!("{:?}", out.quality))
+            .or_insert(0) += 1;
+    };
+    // Interleaved (default): round `seed` plans every scenario once, so that each
+    // scenario's runs spread over the whole bench and a slow spell of the host weighs on
+    // all scenarios alike instead of on whichever ran through it. `--sequential`: each
+    // scenario's runs in a row (a stream of re-plans of one mission).
+    let mut tallies: Vec<Tally> = scenarios.iter().map(|_| Tally::default()).collect();
+    let mut host = Vec::new();
+    if sequential {
+        for ((_, problem), tally) in scenarios.iter().zip(&mut tallies) {
+            host.push(host_reference_ms());
+            for seed in 1..=runs {
+                plan(problem, seed, tally);
+            }
+        }
+    } else {
+        for seed in 1..=runs {
+            host.push(host_reference_ms());
+            for ((_, problem), tally) in scenarios.iter().zip(&mut tallies) {
+                plan(problem, seed, tally);
+            }
+        }
+    }
+    host.push(host_reference_ms());
+    // The peak heap of each scenario's plans, untimed, from an empty workspace pool (the
+    // pool keeps the workspaces it is given back, up to its budget: counted here).
+    let peaks: Vec<f64> = scenarios
+        .iter()
+        .map(|(_, problem)| {
+            wingman_planning::collocation::kkt::clear_workspace_pool();
+            peak_of(|| {
+                for seed in 1..=runs {
+                    plan_once(problem, seed);
+                }
+            }) as f64
+                / (1024.0 * 1024.0)
+        })
+        .collect();
+    println!(
+        "| scenario | median ms | p95 ms | swarm % | NLP % | of it ranking % | rest % | cost min | cost max | spread % | peak heap MiB | quality |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    for (((name, _), tally), peak) in scenarios.iter().zip(&mut tallies).zip(&peaks) {
+        tally.times.sort_by(f64::total_cmp);
+        tally.costs.sort_by(f64::total_cmp);
+        let (times, costs, total) = (&tally.times, &tally.costs, tally.total);
+        let (lo, hi) = (costs[0], costs[costs.len() - 1]);
+        println!(
+            "| {name} | {:.1} | {:.1} | {:.0} | {:.0} | {:.0} | {:.0} | {lo:.6} | {hi:.6} | {:.3} | {peak:.1} | {} |",
+            percentile(times, 0.5),
+            percentile(times, 0.95),
+            100.0 * tally.swarm / total,
+            100.0 * tally.nlp / total,
+            100.0 * tally.ranking / total,
+            100.0 * (total - tally.swarm - tally.nlp) / total,
+            100.0 * (hi - lo) / lo.abs().max(1e-12),
+            tally
+                .qualities
+                .iter()
+                .map(|(q, n)| format!("{q} {n}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        );
+    }
+    let order = if sequential {
+        "before each scenario's runs and at the end"
+    } else {
+        "before each round of all scenarios and at the end"
+    };
+    let text: Vec<String> = host.iter().map(|h| format!("{h:.1}")).collect();
+    host.sort_by(f64::total_cmp);
+    println!(
+        "\nhost ref ms ({order}): {} (min {:.1}, median {:.1}, max {:.1}); {} solves took their KKT workspace from the pool",
+        text.join(" "),
+        host[0],
+        percentile(&host, 0.5),
+        host[host.len() - 1],
+        wingman_planning::collocation::kkt::workspace_reuses_total(),
+    );
+    // Deadline overshoot: a budget far too short for the NLP.
+    println!("\n| scenario | budget ms | returned after ms (median / max of {runs}) | quality |");
+    println!("|---|---:|---:|---|");
+    for name in ["2d-min-time-avoidable", "3d-min-time-rendezvous-avoidable"] {
+        if only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
+            continue;
+        }
+        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+        for budget_ms in [5u64, 20, 50] {
+            let mut over = Vec::new();
+            let mut quality = String::new();
+            // One planner across the runs, as the service keeps one: its estimate of the
+            // NLP's set-up time carries over from plan to plan.
+            let mut planner = Planner::new(&settings);
+            for seed in 1..=runs {
+                let s = PlannerSettings {
+                    swarm: settings.swarm.clone().with_seed(seed),
+                    ..settings.clone()
+                };
+                let began = clock.now();
+                let out = planner
+                    .plan(
+                        &problem,
+                        &s,
+                        Deadline::after(clock, Duration::from_millis(budget_ms)),
+                    )
+                    .unwrap();
+                over.push((clock.now() - began).as_secs_f64() * 1e3);
+                quality = format!("{:?}", out.quality);
+            }
+            over.sort_by(f64::total_cmp);
+            println!(
+                "| {name} | {budget_ms} | {:.1} / {:.1} | {quality} (last) |",
+                percentile(&over, 0.5),
+                over[over.len() - 1]
+            );
+        }
+    }
+}
