@@ -9,7 +9,7 @@ use wingman_planning::estimation::{Estimate, GaussMarkov, KalmanFilter, MovingTh
 use wingman_planning::replan::{PlanPoint, moving_popup_hit, replan_time};
 use wingman_planning::threat::{Superquadric, ThreatLayout};
 
-/// The five static threats of `shared/scenarios/3d-replan-popups.toml` known at take-off
+/// The five static threats of `scenarios/3d-replan-popups.toml` known at take-off
 /// ("popup-far" appears at 300 s and is left out), stiffness 30.
 fn popups_layout() -> ThreatLayout<3> {
     let t = |c: [f64; 3], a: [f64; 3], p: [f64; 3]| Superquadric::new(c, a, p, 0.0).unwrap();

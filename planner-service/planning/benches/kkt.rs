@@ -5,7 +5,7 @@
 //! working), 48 and 72 (3-D). Blocked (`dsytrf`-style panels) against unblocked, each on the dispatched
 //! (AVX2 where present) and the baseline SSE2 path; and one single-column solve.
 //!
-//! `cargo bench -p wingman-planner --bench kkt`
+//! `cargo bench -p wingman-planning --bench kkt`
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use wingman_planning::collocation::bunch_kaufman as bk;

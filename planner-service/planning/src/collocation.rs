@@ -16,5 +16,8 @@ pub use kkt::{KktLabels, KktSolver, StructuredKkt};
 pub use lgr::Lgr;
 pub use mesh::{Layout, Mesh};
 pub use refine::{RefineSettings, interval_errors, refine, split_crossings};
-pub use solve::{NlpOutcome, NlpSettings, NlpStatus, PrimalDual, SolveBudget, solve};
+pub use solve::{
+    FeralOrdering, FeralScaling, MuStrategy, NlpOutcome, NlpSettings, NlpSettingsError, NlpStatus,
+    PrimalDual, SolveBudget, solve,
+};
 pub use transcription::{Transcription, TranscriptionSettings};

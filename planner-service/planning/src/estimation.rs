@@ -178,7 +178,8 @@ impl<const D: usize> Road<D> {
     }
 
     /// Distance along the road of the road point nearest to `w` (the first and last
-    /// segments extended past the ends): the table look-up of a sensor fix (§6.3.2).
+    /// segments extended past the ends): the table look-up of a sensor fix (dissertation
+    /// §6.3.2; docs/FORMULATION.md §5).
     pub fn project(&self, w: &[f64; D]) -> f64 {
         let nseg = self.len - 1;
         let mut best = (f64::INFINITY, 0.0);
@@ -677,7 +678,8 @@ impl KalmanFilter {
         })
     }
 
-    /// Measurement update with a position fix `w`, projected on the road (§6.3.2).
+    /// Measurement update with a position fix `w`, projected on the road (dissertation §6.3.2;
+    /// docs/FORMULATION.md §5).
     pub fn update_position<const D: usize>(
         &mut self,
         road: &Road<D>,

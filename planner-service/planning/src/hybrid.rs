@@ -100,127 +100,61 @@ pub struct PlannerSettings {
     pub crossing_split: Option<f64>,
 }
 
+/// The deployment defaults. Why each is what it is, with what was measured, is in
+/// `docs/decisions/` (the record named beside it).
 impl Default for PlannerSettings {
     fn default() -> Self {
         PlannerSettings {
             swarm: SwarmSettings::default(),
             mesh: MeshSettings::default(),
             transcription: TranscriptionSettings::default(),
-            // The refined (or polished) solves of the winner: they start from its final,
-            // a solution that passed the second-order check in the same basin, so the
-            // check is not repeated (the same iterations and costs on the 15 canonical
-            // scenarios, seeds 1-5); and 1e-6 instead of the solver's 1e-7: 5 % fewer
-            // iterations in those solves, no plan's cost up by more than 1e-5 of it
-            // (docs/BENCHMARKS.md).
-            nlp: NlpSettings {
-                feral_static_pivoting: true,
-                tol: 1e-6,
-                second_order_check: false,
-                ..NlpSettings::default()
-            },
-            // Measured on the 15 canonical scenarios, seeds 1-4: the same winners and plan
-            // costs as at the working tolerance, 15 % less CPU (docs/BENCHMARKS.md). An
-            // acceptable stop must still be feasible enough to rank (below
-            // `ranking_feasibility_tol`, which moves with it): with the solver's default
-            // (1e-2) and `ranking_feasibility_tol` at 1e-4, the swarm's own start of
-            // 2d-fixed-time-unavoidable, seed 3, stopped at 3e-4 and was dropped, and the
-            // plan landed in a basin 18 % higher.
-            ranking_nlp: NlpSettings {
-                feral_static_pivoting: true,
-                tol: 1e-4,
-                acceptable_tol: 1e-3,
-                // One acceptable iterate ends a ranking solve (was two): on the 15
-                // canonical scenarios, seeds 1-20 (300 plans), the same plan costs, 5 %
-                // fewer ranking iterations, 3d-min-time-rendezvous-avoidable -28 % plan
-                // time. Capping the ranking iterations instead (35, 40) lost basins
-                // (2d-fixed-time-unavoidable at 1.18 of the reference; docs/BENCHMARKS.md).
-                acceptable_iter: 1,
-                // 1e-3 (was 1e-5), with `ranking_feasibility_tol` 1e-3: a ranking solve
-                // stops on its first acceptable iterate instead of walking the last
-                // violation down at the next barrier. On the 15 canonical scenarios, seeds
-                // 1-20 (300 plans): 10.5 % fewer ranking iterations, 7.6 % fewer in all, no
-                // plan's cost up by 1e-4 of it, two better (3d-min-time-unavoidable 1.0034
-                // -> 1.0021); 1e-2 gave the same iterations. Paired timing (each seed A B B
-                // A, median per-seed B/A, seeds 1-8): 3d-fixed-time-unavoidable 0.80,
-                // 2d-min-time-rendezvous-unavoidable 0.93, 2d-min-time-unavoidable 0.93,
-                // the others 0.95-1.0 (docs/BENCHMARKS.md).
-                acceptable_constr_viol_tol: Some(1e-3),
-                // The finalists are solved again with the check: here it only cost time
-                // (3 ms per 2-D, 8-10 ms per 3-D ranking solve; the same iterations and
-                // plans on the canonical scenarios, seeds 1-3, judged).
-                second_order_check: false,
-                // No second-order corrections in the line search: on the 15 canonical
-                // scenarios, seeds 1-20 (300 plans), 6.5 % fewer ranking iterations and
-                // 2 % fewer after them, the same worst cost (1.0034 of the reference;
-                // four plans better, two worse, all among the basins already seen);
-                // interleaved probe: 3-D rendezvous -15 %, 2-D within noise.
-                second_order_corrections: false,
-                ..NlpSettings::default()
-            },
-            // Looser than the working tolerance: a refined solve (or a polish on the same
-            // mesh) follows. The violation stays below `nlp.feasibility_tol`, so a finalist
-            // is accepted as the refined ones are.
-            finalist_nlp: NlpSettings {
-                feral_static_pivoting: true,
-                tol: 1e-5,
-                acceptable_tol: 1e-4,
-                acceptable_constr_viol_tol: Some(1e-7),
-                constr_viol_tol: Some(1e-7),
-                ..NlpSettings::default()
-            },
+            // The winner's refined solve: tol 1e-6 (0026), no second-order test (0013).
+            nlp: NlpSettings::default()
+                .with_feral_static_pivoting(true)
+                .with_tol(1e-6)
+                .with_second_order_check(false),
+            // Ranking only tells basins apart: stop at the first acceptable iterate
+            // (0008), no second-order test (0013) or corrections (0027).
+            ranking_nlp: NlpSettings::default()
+                .with_feral_static_pivoting(true)
+                .with_tol(1e-4)
+                .with_acceptable_tol(1e-3)
+                .with_acceptable_iter(1)
+                .with_acceptable_constr_viol_tol(Some(1e-3))
+                .with_second_order_check(false)
+                .with_second_order_corrections(false),
+            // A refined solve or a polish follows; feasible as the refined ones (0022).
+            finalist_nlp: NlpSettings::default()
+                .with_feral_static_pivoting(true)
+                .with_tol(1e-5)
+                .with_acceptable_tol(1e-4)
+                .with_acceptable_constr_viol_tol(Some(1e-7))
+                .with_constr_viol_tol(Some(1e-7)),
             refine: RefineSettings::default(),
-            // One round: on the 15 canonical scenarios (seeds 1-2) a second and third round
-            // moved no plan's cost by 1e-4 of it and took 20-30 % of the plan time (each a
-            // whole solve on the largest mesh, for a few more intervals). Judged with one
-            // round, seeds 1-6: all within 0.5 % of the reference, worst final miss 13.5 m
-            // (limit 50 m).
-            refine_rounds: 1,
+            refine_rounds: 1, // more moved no cost, took 20-30 % of the plan (0011)
             export: ExportSettings::default(),
             swarm_share: 0.3,
-            // Five: on the 15 canonical scenarios, seeds 1-20 (300 plans), the same worst
-            // cost as with six (1.0034 of the reference), two plans better, four
-            // (3d-min-time-rendezvous-avoidable and 3d-replan-popups, seeds 10 and 15) at
-            // 1.0028 instead of 1.0010; the ranking's two-thread makespan 16 % shorter
-            // (counted in iterations). Four missed on 3 of 60 plans (up to 1.18).
-            starts: 5,
-            threads: 2,
+            starts: 5,  // six's worst cost, a 16 % shorter ranking; four lose basins (0021)
+            threads: 2, // the NLP tasks on two threads (0023)
+            // Coarser meshes lose basins; four points only in 3-D (0012).
             ranking_mesh: MeshSettings {
                 points: 5,
                 interval_s: 35.0,
                 min_intervals: 2,
             },
-            // Four points in 3-D: on the 3-D canonical scenarios (seeds 1-6, judged) the
-            // same worst cost (1.0034 of the reference) as with five, 5-30 % less plan
-            // time. In 2-D four points lost the reference basin (docs/BENCHMARKS.md).
             ranking_mesh_3d: MeshSettings {
                 points: 4,
                 interval_s: 35.0,
                 min_intervals: 2,
             },
-            // A small first barrier in 3-D: the starts are whole paths already (the
-            // swarm's best and seeds), not points to be pushed into the interior. On the
-            // 3-D canonical scenarios (seeds 1-5) 25 % fewer ranking iterations than the
-            // solver's 0.1 (up to 45 %), 7 % more in the working-mesh solves, costs within
-            // 0.35 % of the reference, cost spread over seeds 1-20 at most 0.13 %. Not in
-            // 2-D: 6 % fewer iterations, but 3 of 40 plans (2d-min-time-avoidable and
-            // 2d-min-time-rendezvous-unavoidable, seeds 1-20) landed 0.7-3.5 % above the
-            // reference (docs/BENCHMARKS.md).
-            ranking_mu_init_3d: Some(1e-3),
-            // As loose as the ranking's acceptable stop (`ranking_nlp`): a ranked path
-            // is re-evaluated densely and then solved again on the working mesh.
-            ranking_feasibility_tol: 1e-3,
+            ranking_mu_init_3d: Some(1e-3), // 3-D starts are whole paths (0018)
+            ranking_feasibility_tol: 1e-3,  // as loose as the ranking's stop (0008)
+            // Two distinct finalists within 10 % of the best (0020).
             finalists: 2,
             finalist_duplicate_tol: 1e-3,
             finalist_gap_tol: 0.1,
-            warm_mesh_changes: true,
-            // 0.3: a crossing steps the exposure by 0.96-1.0 on the canonical scenarios
-            // (0.1-0.95 split the same intervals), where nothing else moves it by 0.3
-            // within one interval. Paired timing against no split (each seed A B B A,
-            // median of the per-seed ratios, seeds 1-6): 2d-min-time-unavoidable 0.81,
-            // 3d-min-time-unavoidable 0.85, the rendezvous-unavoidable and
-            // 3d-fixed-time-unavoidable ones 0.95-0.97, the others 0.99-1.045 (pairs of the
-            // same settings: 0.96-1.01); costs the same or lower (docs/BENCHMARKS.md).
-            crossing_split: Some(0.3),
+            warm_mesh_changes: true, // 9-28 -> 3-11 iterations per mesh change (0006)
+            crossing_split: Some(0.3), // a crossing steps the exposure by ~1 (0029)
         }
     }
 }
@@ -234,8 +168,85 @@ pub enum PlanError {
     Swarm(#[from] swarm::SwarmError),
     #[error("NLP settings: {0}")]
     Nlp(#[from] crate::collocation::solve::OptionError),
+    #[error("planner settings: {0}")]
+    Settings(#[from] PlannerSettingsError),
     #[error("the planner produced a non-finite trajectory")]
     NonFinite,
+}
+
+/// Planner settings that cannot be used.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlannerSettingsError {
+    #[error("swarm: {0}")]
+    Swarm(#[from] swarm::SwarmError),
+    #[error("`{stage}`: {source}")]
+    Nlp {
+        stage: &'static str,
+        source: crate::collocation::NlpSettingsError,
+    },
+    #[error("`{setting}`: {problem}")]
+    OutOfRange {
+        setting: &'static str,
+        problem: &'static str,
+    },
+}
+
+impl PlannerSettings {
+    /// Checks every stage's settings (the swarm's, the three NLP settings) and the
+    /// planner's own, so that a bad setting is refused before a plan starts.
+    pub fn validate(&self) -> Result<(), PlannerSettingsError> {
+        self.swarm.validate()?;
+        for (stage, nlp) in [
+            ("nlp", &self.nlp),
+            ("ranking_nlp", &self.ranking_nlp),
+            ("finalist_nlp", &self.finalist_nlp),
+        ] {
+            nlp.validate()
+                .map_err(|source| PlannerSettingsError::Nlp { stage, source })?;
+        }
+        let out = |setting: &'static str, problem: &'static str| {
+            Err(PlannerSettingsError::OutOfRange { setting, problem })
+        };
+        let fraction = |x: f64| x.is_finite() && x > 0.0 && x <= 1.0;
+        let non_negative = |x: f64| x.is_finite() && x >= 0.0;
+        if !fraction(self.swarm_share) {
+            return out("swarm_share", "must be in (0, 1]");
+        }
+        if self.starts == 0 {
+            return out("starts", "must be at least 1");
+        }
+        if !(1..=64).contains(&self.threads) {
+            return out("threads", "must be in 1..=64");
+        }
+        if self.finalists == 0 {
+            return out("finalists", "must be at least 1");
+        }
+        if self.refine_rounds > 16 {
+            return out("refine_rounds", "must be at most 16");
+        }
+        for (setting, value) in [
+            ("ranking_feasibility_tol", self.ranking_feasibility_tol),
+            ("finalist_duplicate_tol", self.finalist_duplicate_tol),
+            ("finalist_gap_tol", self.finalist_gap_tol),
+        ] {
+            if !non_negative(value) {
+                return out(setting, "must be finite and non-negative");
+            }
+        }
+        if self
+            .ranking_mu_init_3d
+            .is_some_and(|v| !(v.is_finite() && v > 0.0))
+        {
+            return out("ranking_mu_init_3d", "must be finite and positive when set");
+        }
+        if self
+            .crossing_split
+            .is_some_and(|v| !(v.is_finite() && v > 0.0))
+        {
+            return out("crossing_split", "must be finite and positive when set");
+        }
+        Ok(())
+    }
 }
 
 /// Time spent in each stage.
@@ -640,6 +651,7 @@ impl Planner {
         deadline: Deadline<'static>,
     ) -> Result<PlanOutcome, PlanError> {
         problem.validate()?;
+        settings.validate()?;
         let clock = deadline.clock();
         let started = clock.now();
         let mut times = StageTimes::default();

@@ -1,5 +1,5 @@
 //! Trajectory metrics shared by the optimizer, the harness and the reports, defined as the
-//! judge (`shared/reference/evaluate.py`) defines them: the exposure integral, the minimum
+//! judge (`tools/judge/evaluate.py`) defines them: the exposure integral, the minimum
 //! `F` per threat, final-condition errors, target miss distances and bound violations.
 //!
 //! All functions work on samples the caller owns and never allocate.

@@ -19,7 +19,7 @@
 //! choices that matter (overfly the threats, which are rooted on the ground, or not) and
 //! keep `|gamma|` within its bound and `z >= z_min` by construction.
 //!
-//! The families (`winning_start` in `shared/reference/costs.toml` shows the optimum's basin
+//! The families (`winning_start` in `tools/judge/costs.toml` shows the optimum's basin
 //! is often one of them):
 //! - **arcs**: every combination of straight / left / right per leg for each ratio in
 //!   `bulge_ratios` (`LR@0.5` = left on leg 1, right on leg 2, ratio 0.5), times each

@@ -103,7 +103,7 @@ impl Trajectory {
 }
 
 impl Trajectory {
-    /// The samples as CSV in the judge's format (`../shared/reference/README.md`): a header
+    /// The samples as CSV in the judge's format (`tools/judge/README.md`): a header
     /// row, then `t,x,y,psi,u` (2-D) or `t,x,y,z,gamma,chi,nz,mu,u1,u2` (3-D), SI units and
     /// radians, full precision.
     pub fn to_csv(&self, model: wingman_interfaces::Model) -> String {

@@ -14,8 +14,8 @@ use wingman_planning::estimation::{
 };
 
 // -------------------------------------------------------------------------------------------
-// Reference values printed by shared/reference/scenario.py (numpy 2.4.6, scipy 1.17.1) for
-// the moving threat "mobile-sam" of shared/scenarios/3d-replan-popups.toml
+// Reference values printed by tools/judge/scenario.py (numpy 2.4.6, scipy 1.17.1) for
+// the moving threat "mobile-sam" of scenarios/3d-replan-popups.toml
 // (d0 = 58000 m, v0 = 15 m/s, sigma_a = 0.3 m/s², tau = 60 s, sigma0 = [500, 3, 0.3],
 // road [[70000, 0, 0], [100000, 150000, 0]], axes [10000, 10000, 12000]):
 //

@@ -15,7 +15,7 @@ use wingman_planning::threat::{
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 
-/// The five static threats of `shared/scenarios/3d-replan-popups.toml`, known at take-off.
+/// The five static threats of `scenarios/3d-replan-popups.toml`, known at take-off.
 fn popups_layout() -> ThreatLayout<3> {
     let t = |c: [f64; 3], a: [f64; 3], p: [f64; 3]| Superquadric::new(c, a, p, 0.0).unwrap();
     ThreatLayout::with_threats(
@@ -52,7 +52,7 @@ fn eps_tanh(f: f64, s: f64) -> f64 {
     0.5 * (1.0 + (0.5 * s * (f - 1.0)).tanh())
 }
 
-/// Values printed by `shared/reference/scenario.py` (numpy 2.4.6):
+/// Values printed by `tools/judge/scenario.py` (numpy 2.4.6):
 /// `load_scenario("2d-fixed-time-avoidable.toml")` threat "radar-ridge" and
 /// `load_scenario("3d-replan-popups.toml")` threat "weather", `th.F(pts)`, and
 /// `exposure_eps(F, 30.0)`.

@@ -44,8 +44,8 @@ pub struct NlpSettings {
     pub max_iter: i32,
     /// Largest scaled constraint violation of an iterate that counts as feasible.
     pub feasibility_tol: f64,
-    /// `monotone` or `adaptive`.
-    pub mu_strategy: &'static str,
+    /// How the barrier parameter is updated.
+    pub mu_strategy: MuStrategy,
     /// Warm-start pushes (used with a warm start only).
     pub warm_start_push: f64,
     pub warm_start_mu_init: f64,
@@ -54,13 +54,13 @@ pub struct NlpSettings {
     /// FERAL's own iterative refinement inside each back-solve (pounce already refines
     /// the unreduced Newton system around it).
     pub feral_refine: bool,
-    /// FERAL fill-reducing ordering (`auto`, `amd`, `amf`, `metis`, …).
-    pub feral_ordering: &'static str,
+    /// FERAL fill-reducing ordering.
+    pub feral_ordering: FeralOrdering,
     /// Keep every factorization on the calling thread: the KKT systems of one plan are
     /// small, and rayon's fork/join hand-offs cost more than they save on two cores.
     pub serial_factorization: bool,
-    /// FERAL's diagonal scaling (`auto`, `infnorm`, `mc64`, `identity`).
-    pub feral_scaling: &'static str,
+    /// FERAL's diagonal scaling.
+    pub feral_scaling: FeralScaling,
     /// FERAL static pivoting (force-accept small pivots instead of delaying them).
     pub feral_static_pivoting: bool,
     /// FERAL pivot tolerance (`None`: the solver's default).
@@ -84,8 +84,185 @@ pub struct NlpSettings {
     /// Initial barrier parameter when starting from a previous solution on a refined mesh.
     pub refine_mu_init: f64,
     /// Further solver options by name (`name=value`: a number, an integer or a word), set
-    /// after the ones above; for experiments and expert tuning.
+    /// after the ones above; for experiments and expert tuning. [`NlpSettings::validate`]
+    /// checks that the solver takes each of them.
     pub extra: Vec<(String, String)>,
+}
+
+/// Declares a `&'static str`-valued enum of a solver option: its variants, their option
+/// words and `as_str`.
+macro_rules! option_words {
+    ($(#[$doc:meta])* $name:ident { $($(#[$vdoc:meta])* $variant:ident => $word:literal,)* }) => {
+        $(#[$doc])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        pub enum $name {
+            $($(#[$vdoc])* $variant,)*
+        }
+
+        impl $name {
+            /// The solver's word for it.
+            pub const fn as_str(self) -> &'static str {
+                match self {
+                    $($name::$variant => $word,)*
+                }
+            }
+        }
+    };
+}
+
+option_words! {
+    /// The barrier parameter's update (Ipopt `mu_strategy`).
+    MuStrategy {
+        /// Fiacco–McCormick: the barrier falls once each subproblem is solved.
+        Monotone => "monotone",
+        /// A new barrier every iteration from an oracle.
+        Adaptive => "adaptive",
+    }
+}
+
+option_words! {
+    /// FERAL's fill-reducing ordering (`feral_ordering`).
+    FeralOrdering {
+        /// FERAL picks per matrix.
+        Auto => "auto",
+        /// Approximate minimum degree.
+        Amd => "amd",
+        /// Approximate minimum fill.
+        Amf => "amf",
+        /// Nested dissection (METIS).
+        Metis => "metis",
+    }
+}
+
+option_words! {
+    /// FERAL's diagonal scaling (`feral_scaling`).
+    FeralScaling {
+        /// FERAL picks per matrix.
+        Auto => "auto",
+        /// Iterative infinity-norm equilibration.
+        InfNorm => "infnorm",
+        /// Matching-based symmetric scaling.
+        Mc64 => "mc64",
+        /// No scaling.
+        Identity => "identity",
+    }
+}
+
+/// NLP settings that cannot be used.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum NlpSettingsError {
+    /// A setting out of its range.
+    #[error("NLP setting `{setting}`: {problem}")]
+    OutOfRange {
+        setting: &'static str,
+        problem: &'static str,
+    },
+    /// An extra option the solver refuses.
+    #[error(transparent)]
+    Refused(#[from] OptionError),
+}
+
+/// A builder method per setting: `with_<name>(value)`.
+macro_rules! nlp_setter {
+    ($($(#[$doc:meta])* $fn_name:ident, $field:ident, $ty:ty;)*) => {$(
+        $(#[$doc])*
+        pub fn $fn_name(mut self, value: $ty) -> Self {
+            self.$field = value;
+            self
+        }
+    )*};
+}
+
+impl NlpSettings {
+    nlp_setter! {
+        /// Sets [`NlpSettings::tol`].
+        with_tol, tol, f64;
+        /// Sets [`NlpSettings::acceptable_tol`].
+        with_acceptable_tol, acceptable_tol, f64;
+        /// Sets [`NlpSettings::acceptable_iter`].
+        with_acceptable_iter, acceptable_iter, i32;
+        /// Sets [`NlpSettings::acceptable_constr_viol_tol`].
+        with_acceptable_constr_viol_tol, acceptable_constr_viol_tol, Option<f64>;
+        /// Sets [`NlpSettings::constr_viol_tol`].
+        with_constr_viol_tol, constr_viol_tol, Option<f64>;
+        /// Sets [`NlpSettings::max_iter`].
+        with_max_iter, max_iter, i32;
+        /// Sets [`NlpSettings::feasibility_tol`].
+        with_feasibility_tol, feasibility_tol, f64;
+        /// Sets [`NlpSettings::mu_strategy`].
+        with_mu_strategy, mu_strategy, MuStrategy;
+        /// Sets [`NlpSettings::feral_ordering`].
+        with_feral_ordering, feral_ordering, FeralOrdering;
+        /// Sets [`NlpSettings::feral_scaling`].
+        with_feral_scaling, feral_scaling, FeralScaling;
+        /// Sets [`NlpSettings::feral_static_pivoting`].
+        with_feral_static_pivoting, feral_static_pivoting, bool;
+        /// Sets [`NlpSettings::second_order_check`].
+        with_second_order_check, second_order_check, bool;
+        /// Sets [`NlpSettings::second_order_corrections`].
+        with_second_order_corrections, second_order_corrections, bool;
+        /// Sets [`NlpSettings::kkt`].
+        with_kkt, kkt, KktSolver;
+        /// Sets [`NlpSettings::mu_init`].
+        with_mu_init, mu_init, Option<f64>;
+        /// Sets [`NlpSettings::refine_mu_init`].
+        with_refine_mu_init, refine_mu_init, f64;
+    }
+
+    /// Adds an extra solver option (see [`NlpSettings::extra`]).
+    pub fn with_extra(mut self, name: impl Into<String>, value: impl Into<String>) -> Self {
+        self.extra.push((name.into(), value.into()));
+        self
+    }
+
+    /// Checks every setting is in range and the solver takes every extra option, so that
+    /// a bad setting is refused when the planner is built, not by the solver mid-plan.
+    pub fn validate(&self) -> Result<(), NlpSettingsError> {
+        let out = |setting: &'static str, problem: &'static str| {
+            Err(NlpSettingsError::OutOfRange { setting, problem })
+        };
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        for (setting, value) in [
+            ("tol", self.tol),
+            ("acceptable_tol", self.acceptable_tol),
+            ("feasibility_tol", self.feasibility_tol),
+            ("warm_start_push", self.warm_start_push),
+            ("warm_start_mu_init", self.warm_start_mu_init),
+            ("refine_mu_init", self.refine_mu_init),
+        ] {
+            if !positive(value) {
+                return out(setting, "must be finite and positive");
+            }
+        }
+        for (setting, value) in [
+            (
+                "acceptable_constr_viol_tol",
+                self.acceptable_constr_viol_tol,
+            ),
+            ("constr_viol_tol", self.constr_viol_tol),
+            ("feral_pivtol", self.feral_pivtol),
+            ("mu_init", self.mu_init),
+        ] {
+            if value.is_some_and(|v| !positive(v)) {
+                return out(setting, "must be finite and positive when set");
+            }
+        }
+        if self.max_iter < 1 {
+            return out("max_iter", "must be at least 1");
+        }
+        if self.acceptable_iter < 0 {
+            return out("acceptable_iter", "must not be negative");
+        }
+        if !(0..=12).contains(&self.print_level) {
+            return out("print_level", "must be in 0..=12");
+        }
+        if !self.extra.is_empty() {
+            let mut app = IpoptApplication::new();
+            let _ = app.initialize();
+            set_extra_options(app.options_mut(), &self.extra)?;
+        }
+        Ok(())
+    }
 }
 
 impl Default for NlpSettings {
@@ -98,14 +275,14 @@ impl Default for NlpSettings {
             constr_viol_tol: None,
             max_iter: 300,
             feasibility_tol: 1e-6,
-            mu_strategy: "monotone",
+            mu_strategy: MuStrategy::Monotone,
             warm_start_push: 1e-6,
             warm_start_mu_init: 1e-6,
             print_level: 0,
             feral_refine: false,
-            feral_ordering: "amf",
+            feral_ordering: FeralOrdering::Amf,
             serial_factorization: true,
-            feral_scaling: "identity",
+            feral_scaling: FeralScaling::Identity,
             feral_static_pivoting: false,
             feral_pivtol: None,
             second_order_check: true,
@@ -444,7 +621,7 @@ fn application(
             })
     };
     text(o, "hessian_approximation", "exact")?;
-    text(o, "mu_strategy", settings.mu_strategy)?;
+    text(o, "mu_strategy", settings.mu_strategy.as_str())?;
     text(o, "linear_solver", "feral")?;
     let flag = |o: &mut OptionsList, name: &'static str, v: bool| {
         o.set_bool_value(name, v, true, false)
@@ -459,8 +636,8 @@ fn application(
     flag(o, "dual_divergence_retry", false)?;
     flag(o, "honor_original_bounds", true)?;
     flag(o, "feral_refine", settings.feral_refine)?;
-    text(o, "feral_ordering", settings.feral_ordering)?;
-    text(o, "feral_scaling", settings.feral_scaling)?;
+    text(o, "feral_ordering", settings.feral_ordering.as_str())?;
+    text(o, "feral_scaling", settings.feral_scaling.as_str())?;
     flag(o, "feral_static_pivoting", settings.feral_static_pivoting)?;
     if let Some(p) = settings.feral_pivtol {
         num(o, "feral_pivtol", p)?;
@@ -493,11 +670,17 @@ fn application(
         }
         num(o, "mu_init", settings.warm_start_mu_init)?;
     }
-    for (name, value) in &settings.extra {
-        let refused = |e: String| OptionError {
-            name: "extra",
-            reason: format!("{name}={value}: {e}"),
-        };
+    set_extra_options(o, &settings.extra)?;
+    install_restoration(&mut app);
+    if settings.kkt == KktSolver::Structured {
+        install_structured_kkt(&mut app, labels);
+    }
+    Ok(app)
+}
+
+/// Sets `extra` (`name=value`: an integer, a number or a word) on `o`, after the others.
+fn set_extra_options(o: &mut OptionsList, extra: &[(String, String)]) -> Result<(), OptionError> {
+    for (name, value) in extra {
         let done = if let Ok(i) = value.parse::<i32>() {
             o.set_integer_value(name, i, true, false).is_ok()
                 || o.set_numeric_value(name, f64::from(i), true, false).is_ok()
@@ -507,14 +690,13 @@ fn application(
             o.set_string_value(name, value, true, false).is_ok()
         };
         if !done {
-            return Err(refused("refused".into()));
+            return Err(OptionError {
+                name: "extra",
+                reason: format!("{name}={value}: refused"),
+            });
         }
     }
-    install_restoration(&mut app);
-    if settings.kkt == KktSolver::Structured {
-        install_structured_kkt(&mut app, labels);
-    }
-    Ok(app)
+    Ok(())
 }
 
 /// Plugs the structured KKT backend into `app`'s main algorithm, falling back to FERAL

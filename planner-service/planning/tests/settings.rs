@@ -1,0 +1,95 @@
+//! The planner's settings are checked when a plan starts, with a typed error naming the
+//! setting, not refused by the solver mid-plan.
+
+use std::time::Duration;
+
+use wingman_planning::clock::{Deadline, ManualClock};
+use wingman_planning::collocation::{FeralOrdering, MuStrategy, NlpSettings, NlpSettingsError};
+use wingman_planning::hybrid::{PlanError, Planner, PlannerSettings, PlannerSettingsError};
+use wingman_planning::problem::Problem;
+use wingman_planning::scenario::bundled;
+
+#[test]
+fn the_default_settings_are_valid() {
+    assert_eq!(NlpSettings::default().validate(), Ok(()));
+    assert_eq!(PlannerSettings::default().validate(), Ok(()));
+}
+
+#[test]
+fn the_builder_sets_what_it_names() {
+    let s = NlpSettings::default()
+        .with_tol(1e-5)
+        .with_mu_strategy(MuStrategy::Adaptive)
+        .with_feral_ordering(FeralOrdering::Metis)
+        .with_extra("max_soc", "2");
+    assert_eq!(s.tol, 1e-5);
+    assert_eq!(s.mu_strategy.as_str(), "adaptive");
+    assert_eq!(s.feral_ordering.as_str(), "metis");
+    assert_eq!(s.extra, vec![("max_soc".to_string(), "2".to_string())]);
+    assert_eq!(s.validate(), Ok(()));
+}
+
+#[test]
+fn out_of_range_settings_are_refused_by_name() {
+    for (settings, name) in [
+        (NlpSettings::default().with_tol(0.0), "tol"),
+        (NlpSettings::default().with_tol(f64::NAN), "tol"),
+        (NlpSettings::default().with_max_iter(0), "max_iter"),
+        (NlpSettings::default().with_mu_init(Some(-1.0)), "mu_init"),
+        (
+            NlpSettings::default().with_acceptable_iter(-1),
+            "acceptable_iter",
+        ),
+    ] {
+        match settings.validate() {
+            Err(NlpSettingsError::OutOfRange { setting, .. }) => assert_eq!(setting, name),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn an_extra_option_the_solver_does_not_know_is_refused_at_validation() {
+    let bad = NlpSettings::default().with_extra("no_such_option", "1");
+    assert!(matches!(bad.validate(), Err(NlpSettingsError::Refused(_))));
+    let bad_word = NlpSettings::default().with_extra("mu_strategy", "sideways");
+    assert!(matches!(
+        bad_word.validate(),
+        Err(NlpSettingsError::Refused(_))
+    ));
+}
+
+#[test]
+fn a_plan_with_bad_settings_fails_before_it_starts() {
+    let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();
+    let problem = Problem::from_scenario(&sc).unwrap();
+    let mut settings = PlannerSettings::default();
+    settings.ranking_nlp = settings.ranking_nlp.with_extra("no_such_option", "1");
+    let clock: &'static ManualClock = Box::leak(Box::new(ManualClock::new()));
+    let err = Planner::new(&settings)
+        .plan(
+            &problem,
+            &settings,
+            Deadline::after(clock, Duration::from_secs(10)),
+        )
+        .expect_err("bad settings");
+    assert!(
+        matches!(
+            err,
+            PlanError::Settings(PlannerSettingsError::Nlp {
+                stage: "ranking_nlp",
+                ..
+            })
+        ),
+        "{err}"
+    );
+    let mut settings = PlannerSettings::default();
+    settings.swarm_share = 1.5;
+    assert!(matches!(
+        settings.validate(),
+        Err(PlannerSettingsError::OutOfRange {
+            setting: "swarm_share",
+            ..
+        })
+    ));
+}
