@@ -46,6 +46,17 @@
 //! [`SparseSymLinearSolverInterface::increase_quality`], the answer is FERAL's (the
 //! planner's FERAL declines, and pounce perturbs); if FERAL escalates, it also takes over
 //! the rest of the solve.
+//!
+//! Its parts: `labels` (the block labelling), `workspace` (the buffers) and `symbolic`
+//! (their layout for a pattern, `Workspace::new`), `factor` (block elimination), `groups`
+//! (the pivot groups), `surplus` (the early stop on a surplus of negative eigenvalues),
+//! `solve` (solves and refinement), `backend` ([`StructuredKkt`], the pounce interface),
+//! `pool` (workspaces kept across solves) and `counters` (process-wide diagnostics).
+//!
+//! [`Transcription`]: super::transcription::Transcription
+//! [`FeralSolverInterface`]: pounce_feral::FeralSolverInterface
+//! [`SparseSymLinearSolverInterface::initialize_structure`]: pounce_linsol::SparseSymLinearSolverInterface::initialize_structure
+//! [`SparseSymLinearSolverInterface::increase_quality`]: pounce_linsol::SparseSymLinearSolverInterface::increase_quality
 
 mod backend;
 mod counters;

@@ -10,7 +10,7 @@ pub(super) static FERAL_FALLBACKS: std::sync::atomic::AtomicUsize =
     std::sync::atomic::AtomicUsize::new(0);
 
 /// Factorisations block elimination stopped early on a certain surplus of negative
-/// eigenvalues (see [`Workspace::surplus`]), over the process.
+/// eigenvalues (see [`super::Workspace::surplus`]), over the process.
 pub(super) static SURPLUS_STOPS: std::sync::atomic::AtomicUsize =
     std::sync::atomic::AtomicUsize::new(0);
 
