@@ -8,7 +8,7 @@
 //! `cargo bench -p wingman-planning --bench kkt`
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use wingman_planning::collocation::bunch_kaufman as bk;
+use wingman_planning::linalg::bunch_kaufman as bk;
 
 mod common;
 use common::kkt_block;

@@ -80,7 +80,7 @@ fn host_reference_ms() -> f64 {
 /// One thread's part of [`host_reference_ms`]: the block of the kkt bench's `n = 72`
 /// case (42 primal and 30 dual rows).
 fn reference_workload_ms() -> f64 {
-    use wingman_planning::collocation::bunch_kaufman as bk;
+    use wingman_planning::linalg::bunch_kaufman as bk;
     const N: usize = 72;
     let k = kkt_block(42, 30, N as u64);
     let mut a = k.clone();

@@ -1,7 +1,6 @@
 //! Direct orthogonal collocation at Legendre–Gauss–Radau points (FORMULATION.md §4): the
 //! LGR scheme, the mesh and node layout, and the sparse NLP of the transcription.
 
-pub mod bunch_kaufman;
 pub mod export;
 pub mod kkt;
 pub mod lgr;

@@ -14,6 +14,7 @@ pub mod dynamics;
 pub mod estimation;
 pub mod hybrid;
 pub mod lead;
+pub mod linalg;
 pub mod metrics;
 pub mod plan_message;
 pub mod problem;
