@@ -18,15 +18,18 @@
 
 mod cost;
 mod flight;
+mod from_seed;
 mod grid;
 mod output;
 mod passes;
-mod track;
 
 pub(crate) use cost::{Report, Score, evaluate};
+pub(crate) use from_seed::track;
 pub(crate) use grid::{Grid, GridParams};
 pub(crate) use output::{OutBuffers, write_trajectory};
-pub(crate) use track::track;
+
+#[cfg(doc)]
+use crate::trajectory::Trajectory;
 
 /// Per-thread buffers of one evaluation.
 #[derive(Debug, Clone)]

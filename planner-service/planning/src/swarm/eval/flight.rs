@@ -5,6 +5,8 @@
 
 use std::f64::consts::FRAC_PI_2;
 
+#[cfg(doc)]
+use crate::dynamics;
 use crate::dynamics::G0;
 
 use super::Scratch;

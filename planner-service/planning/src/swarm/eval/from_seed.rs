@@ -3,6 +3,8 @@
 
 use crate::seeding::Seed;
 
+#[cfg(doc)]
+use super::flight::Flyer;
 use super::flight::{Guide, State, pursuit, spatial_controls, step_planar, step_spatial};
 use super::grid::Grid;
 
