@@ -81,7 +81,7 @@ pub fn same_class(a: &Signature, b: &Signature) -> bool {
 
 /// A seed flown at the vehicle's speed as a full-model trajectory (3-D: lifted with eqs.
 /// 5.13–5.15), with its targets' pass times as phase ends.
-pub fn seed_trajectory(problem: &Problem, seed: &Seed) -> Option<Trajectory> {
+pub fn path_of_seed(problem: &Problem, seed: &Seed) -> Option<Trajectory> {
     let pts = seed.points();
     let n = pts.len();
     if n < 3 {
@@ -216,7 +216,7 @@ fn ranked_seeds(
     threads: usize,
     cost: &(impl Fn(&Trajectory) -> f64 + Sync),
 ) -> Vec<(f64, usize, Trajectory)> {
-    let path = |i: usize| seed_trajectory(problem, &seeds[i]).map(|tr| (cost(&tr), i, tr));
+    let path = |i: usize| path_of_seed(problem, &seeds[i]).map(|tr| (cost(&tr), i, tr));
     let threads = threads.clamp(1, seeds.len().max(1));
     let share = |t: usize| (t..seeds.len()).step_by(threads).filter_map(path);
     if threads == 1 {
@@ -279,7 +279,7 @@ mod tests {
             let mut all = Vec::new();
             seeds(&problem, &SeedSettings::default(), &mut all).unwrap();
             assert!(all.len() > 8, "{name}: {} seeds", all.len());
-            let first = seed_trajectory(&problem, &all[0]).expect("a path");
+            let first = path_of_seed(&problem, &all[0]).expect("a path");
             let cost = |tr: &Trajectory| crate::hybrid::trajectory_cost(&problem, tr);
             let one = candidates(&problem, &first, &all, 5, 1, cost);
             assert!(one.len() >= 3, "{name}: {} starts", one.len());

@@ -10,7 +10,7 @@ pub mod solve;
 pub mod transcription;
 pub mod warm;
 
-pub use export::{ExportSettings, export, fly};
+pub use export::{ExportSettings, export, fly_reference};
 pub use kkt::{KktLabels, KktSolver, StructuredKkt};
 pub use lgr::Lgr;
 pub use mesh::{Layout, Mesh};

@@ -22,7 +22,7 @@ use crate::basins;
 use crate::clock::Deadline;
 use crate::collocation::{
     ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, RefineSettings, SolveBudget,
-    Transcription, TranscriptionSettings, export, fly, interval_errors, refine, solve,
+    Transcription, TranscriptionSettings, export, fly_reference, interval_errors, refine, solve,
     split_crossings,
 };
 use crate::problem::Problem;
@@ -347,7 +347,7 @@ fn solve_on_mesh(
     job: MeshSolve<'_>,
     deadline: Deadline<'static>,
     timing: SolveTiming,
-) -> SolveResult {
+) -> MeshSolveResult {
     let MeshSolve {
         problem,
         mesh,
@@ -424,29 +424,29 @@ fn solve_on_mesh(
 }
 
 /// A mesh solve's accepted result (if any), iterations, status and timing.
-type SolveResult = Result<(Option<Solved>, usize, NlpStatus, SolveTiming), PlanError>;
+type MeshSolveResult = Result<(Option<Solved>, usize, NlpStatus, SolveTiming), PlanError>;
 
 /// The accepted solution of a solve's result, if any.
-fn accepted_of(r: &SolveResult) -> Option<&Solved> {
+fn accepted_of(r: &MeshSolveResult) -> Option<&Solved> {
     r.as_ref().ok().and_then(|r| r.0.as_ref())
 }
 
 /// A start's ranking solve on the coarse mesh and, if it was accepted, the path exported
 /// from it with its dense cost.
 struct Ranked {
-    result: SolveResult,
+    result: MeshSolveResult,
     path: Option<(f64, Trajectory)>,
 }
 
 /// A finalist's solve on the working mesh.
 struct Finaled {
-    result: SolveResult,
+    result: MeshSolveResult,
     mesh: Mesh,
 }
 
 /// A refinement round: its solve and mesh (`None`: the mesh needed no refinement and
 /// there was nothing to polish).
-type Rounded = Option<(SolveResult, Mesh)>;
+type Rounded = Option<(MeshSolveResult, Mesh)>;
 
 /// The NLP stage of one plan, as [`schedule`] runs it.
 struct NlpStage<'a> {
@@ -469,7 +469,7 @@ struct NlpStage<'a> {
 impl NlpStage<'_> {
     /// Runs `job` with the timing known now (recent plans' and this one's so far), and
     /// records its own.
-    fn solve(&self, job: MeshSolve<'_>) -> SolveResult {
+    fn solve(&self, job: MeshSolve<'_>) -> MeshSolveResult {
         let result = solve_on_mesh(job, self.deadline, self.timing.max(self.seen.get()));
         if let Ok((_, _, _, seen)) = &result {
             self.seen.record(*seen);
@@ -688,7 +688,7 @@ impl Planner {
         let fallback_started = clock.now();
         let mut fallback = sw.best.resampled(settings.export.max_step_s);
         if problem.dim() == 3 {
-            fly(problem, &settings.export, &mut fallback);
+            fly_reference(problem, &settings.export, &mut fallback);
         }
         let fallback_cost = clock.now().saturating_sub(fallback_started);
         let deadline = deadline.earlier(fallback_cost * 2);

@@ -134,7 +134,7 @@ pub fn export(tr: &Transcription, x: &[f64], settings: &ExportSettings, out: &mu
         }
     }
     if settings.closed_loop && tr.nu == 2 {
-        fly(&tr.problem, settings, out);
+        fly_reference(&tr.problem, settings, out);
     }
 }
 
@@ -142,7 +142,11 @@ pub fn export(tr: &Transcription, x: &[f64], settings: &ExportSettings, out: &mu
 /// by the tracking law following them, from the reference's first state (see the module
 /// documentation). Any sampled trajectory of `problem` can be flown this way (e.g. the
 /// swarm's lifted path when the NLP had no time).
-pub fn fly(problem: &crate::problem::Problem, settings: &ExportSettings, out: &mut Trajectory) {
+pub fn fly_reference(
+    problem: &crate::problem::Problem,
+    settings: &ExportSettings,
+    out: &mut Trajectory,
+) {
     let vehicle = Vehicle::new(problem);
     let tracker = Tracker::new(problem, settings.gains);
     let n = out.len();

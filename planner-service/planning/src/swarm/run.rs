@@ -111,7 +111,7 @@ pub fn run(
     let result = crossbeam::scope(|scope| {
         workers.spawn(scope);
         let _guard = AbortOnUnwind(&barrier);
-        sw.fly(&workers)
+        sw.fly_rounds(&workers)
     });
     match result {
         Ok(true) => {}
@@ -224,7 +224,7 @@ pub(super) struct Swarm<'a> {
 impl Swarm<'_> {
     /// Every round on the worker threads, from the seeds to the last iteration; stops the
     /// workers. False when a worker died.
-    fn fly(&mut self, workers: &Workers<'_>) -> bool {
+    fn fly_rounds(&mut self, workers: &Workers<'_>) -> bool {
         let Some(round) = self.score_seeds(workers) else {
             return false;
         };

@@ -8,7 +8,7 @@ use crate::dynamics::wrap_angle;
 use super::Scratch;
 use super::flight::Flyer;
 use super::grid::{End, Grid};
-use super::passes::{Pass, Tracker};
+use super::passes::{Pass, Passes};
 
 /// A particle's swarm cost; infeasible (a pass beyond `D*`) ranks after every feasible.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,7 +60,7 @@ pub(crate) struct Report {
 /// plus the swarm's penalties (eqs. 4.5–4.8 in additive form, see the `swarm` module).
 pub(crate) fn evaluate(g: &Grid, u: &[f64], sc: &mut Scratch) -> Report {
     let mut fly = Flyer::start(g, sc);
-    let mut tr = Tracker::new();
+    let mut tr = Passes::new();
     let mut fed = 0;
     let mut done = false;
     'steps: for k in 0..g.steps {

@@ -1,5 +1,5 @@
 //! Where a path passes the targets and the end ([`Pass`]), found segment by segment while
-//! the particle is flown ([`Tracker`]).
+//! the particle is flown ([`Passes`]).
 
 use wingman_interfaces::{MAX_PHASES, Objective};
 
@@ -62,7 +62,7 @@ pub(super) fn sub3(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
 /// offers its closest approach and the one with the least `w_d dist + w_t |t - t_fixed|`
 /// wins; flying stops once a run has closed after `t_fixed`, or when `w_t (t - t_fixed)`
 /// alone exceeds the best offer.
-pub(super) struct Tracker {
+pub(super) struct Passes {
     phase: usize,
     from: usize,
     inside: bool,
@@ -75,9 +75,9 @@ pub(super) struct Tracker {
     pub(super) ok: [bool; MAX_PHASES],
 }
 
-impl Tracker {
+impl Passes {
     pub(super) fn new() -> Self {
-        Tracker {
+        Passes {
             phase: 0,
             from: 0,
             inside: false,
