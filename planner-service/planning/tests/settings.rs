@@ -83,8 +83,10 @@ fn a_plan_with_bad_settings_fails_before_it_starts() {
         ),
         "{err}"
     );
-    let mut settings = PlannerSettings::default();
-    settings.swarm_share = 1.5;
+    let settings = PlannerSettings {
+        swarm_share: 1.5,
+        ..PlannerSettings::default()
+    };
     assert!(matches!(
         settings.validate(),
         Err(PlannerSettingsError::OutOfRange {
