@@ -27,10 +27,12 @@
 //! `PAIR name seed A-ms B-ms` (the means of each pair) and per scenario the median of the
 //! B/A ratios: a comparison that a slow spell of the host weighs on alike.
 
+use std::sync::Arc;
 use std::time::Duration;
 
 use wingman_planning::clock::{Deadline, MonotonicClock};
 use wingman_planning::collocation::KktSolver;
+use wingman_planning::collocation::kkt::KktCache;
 use wingman_planning::hybrid::{Planner, PlannerSettings};
 use wingman_planning::problem::Problem;
 use wingman_planning::scenario::{BUNDLED, bundled};
@@ -179,6 +181,8 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let filter = args.get(1).cloned().unwrap_or_default();
     let runs: u64 = args.get(2).and_then(|v| v.parse().ok()).unwrap_or(3);
+    // The KKT workspaces and factorisation counts of every planner below.
+    let kkt = Arc::new(KktCache::new());
     let refs: toml::Table = toml::from_str(
         &std::fs::read_to_string(concat!(
             env!("CARGO_MANIFEST_DIR"),
@@ -218,7 +222,7 @@ fn main() {
         let mut pairs: Vec<(f64, f64)> = Vec::new();
         // One planner per scenario, as the service keeps one: its workspace and its
         // estimate of the NLP's set-up time carry over from plan to plan.
-        let mut planner = Planner::new(&s);
+        let mut planner = Planner::with_kkt_cache(&s, Arc::clone(&kkt));
         let first = env::<u64>("PROBE_FIRST_SEED").unwrap_or(1);
         for seed in first..first + runs {
             let st = PlannerSettings {
@@ -360,14 +364,15 @@ fn main() {
         );
     }
     println!("worst cost/ref {worst:.5}");
+    let counts = kkt.counts();
     println!(
         "KKT factorisations: {} by block elimination ({} without pivot groups, {} stopped on a \
          surplus of negative eigenvalues), {} handed to FERAL; {} solves took their \
          workspace from the pool",
-        wingman_planning::collocation::kkt::block_factorizations_total(),
-        wingman_planning::collocation::kkt::plain_factorizations_total(),
-        wingman_planning::collocation::kkt::surplus_stops_total(),
-        wingman_planning::collocation::kkt::feral_fallbacks_total(),
-        wingman_planning::collocation::kkt::workspace_reuses_total()
+        counts.block_factorizations,
+        counts.plain_factorizations,
+        counts.surplus_stops,
+        counts.feral_fallbacks,
+        kkt.workspace_reuses()
     );
 }

@@ -20,6 +20,7 @@ use wingman_interfaces::Quality;
 
 use crate::basins;
 use crate::clock::Deadline;
+use crate::collocation::kkt::KktCache;
 use crate::collocation::{
     ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, RefineSettings, SolveBudget,
     Transcription, TranscriptionSettings, export, fly_reference, interval_errors, refine, solve,
@@ -303,6 +304,9 @@ pub struct Planner {
     /// Per model: how long recent plans' ranking and fallback took, to decide whether a
     /// budget can hold the NLP stage at all.
     stage: [StageTiming; 2],
+    /// The KKT workspaces of recent solves, kept for solves of the same pattern, and the
+    /// factorisations' counters: the planner's own, shared by its threads.
+    kkt: Arc<KktCache>,
 }
 
 /// One NLP solve's accepted result.
@@ -347,6 +351,7 @@ fn solve_on_mesh(
     job: MeshSolve<'_>,
     deadline: Deadline<'static>,
     timing: SolveTiming,
+    kkt: &Arc<KktCache>,
 ) -> MeshSolveResult {
     let MeshSolve {
         problem,
@@ -399,7 +404,7 @@ fn solve_on_mesh(
         iteration: timing.iteration(vars),
         wrap_up: timing.wrap_up,
     };
-    let (tr, out) = solve(tr, start, warm, &nlp, budget)?;
+    let (tr, out) = solve(tr, start, warm, &nlp, budget, kkt)?;
     let seen = SolveTiming {
         setup: out.first_iteration.unwrap_or_default(),
         per_var: out.longest_iteration.as_secs_f64() / vars.max(1) as f64,
@@ -464,13 +469,16 @@ struct NlpStage<'a> {
     /// The timing of this plan's solves so far.
     seen: Seen,
     deadline: Deadline<'static>,
+    /// The planner's pool of KKT workspaces and its counters.
+    kkt: &'a Arc<KktCache>,
 }
 
 impl NlpStage<'_> {
     /// Runs `job` with the timing known now (recent plans' and this one's so far), and
     /// records its own.
     fn solve(&self, job: MeshSolve<'_>) -> MeshSolveResult {
-        let result = solve_on_mesh(job, self.deadline, self.timing.max(self.seen.get()));
+        let timing = self.timing.max(self.seen.get());
+        let result = solve_on_mesh(job, self.deadline, timing, self.kkt);
         if let Ok((_, _, _, seen)) = &result {
             self.seen.record(*seen);
         }
@@ -629,12 +637,26 @@ impl schedule::Stage for NlpStage<'_> {
 }
 
 impl Planner {
+    /// A planner with its own pool of KKT workspaces.
     pub fn new(settings: &PlannerSettings) -> Planner {
+        Planner::with_kkt_cache(settings, Arc::new(KktCache::new()))
+    }
+
+    /// A planner whose solves pool their KKT workspaces in `kkt`, which other planners may
+    /// share (a benchmark that plans each time with a fresh planner, as a service keeps
+    /// one).
+    pub fn with_kkt_cache(settings: &PlannerSettings, kkt: Arc<KktCache>) -> Planner {
         Planner {
             swarm: SwarmWorkspace::new(&settings.swarm),
             timing: [SolveTiming::prior(false), SolveTiming::prior(true)],
             stage: [StageTiming::prior(false), StageTiming::prior(true)],
+            kkt,
         }
+    }
+
+    /// The planner's pool of KKT workspaces and its factorisations' counters.
+    pub fn kkt_cache(&self) -> &Arc<KktCache> {
+        &self.kkt
     }
 
     /// The seeds of the last plan (for plots).
@@ -754,6 +776,7 @@ impl Planner {
             timing,
             seen: Seen::default(),
             deadline,
+            kkt: &self.kkt,
         };
         let done = if no_time {
             schedule::Schedule::none()

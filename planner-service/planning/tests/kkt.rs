@@ -2,10 +2,11 @@
 //! with it reaches the objective of a solve with FERAL, and its factorise-and-solve loop
 //! does not allocate.
 
+use std::sync::Arc;
 use std::time::Duration;
 
 use wingman_planning::clock::Deadline;
-use wingman_planning::collocation::kkt::block_factorizations_total;
+use wingman_planning::collocation::kkt::KktCache;
 use wingman_planning::collocation::{
     KktLabels, KktSolver, Mesh, NlpSettings, NlpStatus, PrimalDual, SolveBudget, StructuredKkt,
     Transcription, TranscriptionSettings, solve,
@@ -43,13 +44,14 @@ fn same_objective(name: &str) {
             mu_init: Some(1e-3),
             ..NlpSettings::default()
         };
-        let before = block_factorizations_total();
+        let cache = Arc::new(KktCache::new());
         let (_, out) = solve(
             tr,
             start,
             false,
             &nlp,
             SolveBudget::until(Deadline::after(clock(), Duration::from_secs(60))),
+            &cache,
         )
         .unwrap();
         assert_eq!(
@@ -60,7 +62,7 @@ fn same_objective(name: &str) {
         );
         if kkt == KktSolver::Structured {
             assert!(
-                block_factorizations_total() > before,
+                cache.counts().block_factorizations > 0,
                 "no block factorisation"
             );
         }
@@ -202,7 +204,8 @@ fn labels_fit_and_do_not_allocate(name: &str) {
             Entry::Slack => -1.0,
         })
         .collect();
-    let mut solver = StructuredKkt::new(Some(labels), Default::default());
+    let mut solver =
+        StructuredKkt::new(Some(labels), Default::default(), Arc::new(KktCache::new()));
     let nnz = ia.len() as i32;
     assert_eq!(
         solver.initialize_structure(dim as i32, nnz, &ia, &ja),
@@ -310,7 +313,11 @@ fn surplus_stops_agree_with_the_eigenvalues(name: &str) {
     let tr = Transcription::new(&p, &mesh, &guess, &TranscriptionSettings::default());
     let (dim, m, entries) = kkt_pattern(&tr);
     let (ia, ja) = triplets(&entries);
-    let mut solver = StructuredKkt::new(Some(KktLabels::of(&tr)), Default::default());
+    let mut solver = StructuredKkt::new(
+        Some(KktLabels::of(&tr)),
+        Default::default(),
+        Arc::new(KktCache::new()),
+    );
     assert_eq!(
         solver.initialize_structure(dim as i32, ia.len() as i32, &ia, &ja),
         ESymSolverStatus::Success

@@ -3,9 +3,11 @@
 //! the new mesh's NLP, evaluated independently here from its gradient and Jacobian, and the
 //! warm-started solve is checked to need fewer iterations than a cold one.
 
+use std::sync::Arc;
 use std::time::Duration;
 
 use wingman_planning::clock::Deadline;
+use wingman_planning::collocation::kkt::KktCache;
 use wingman_planning::collocation::warm::transfer;
 use wingman_planning::collocation::{
     ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, SolveBudget, Transcription,
@@ -60,6 +62,7 @@ fn solve_counted(
         is_warm,
         &settings,
         SolveBudget::until(Deadline::after(clock(), Duration::from_secs(60))),
+        &Arc::new(KktCache::new()),
     )
     .unwrap();
     assert_eq!(out.status, NlpStatus::Converged, "{:?}", out.return_status);

@@ -51,7 +51,8 @@
 //! (their layout for a pattern, `Workspace::new`), `factor` (block elimination), `groups`
 //! (the pivot groups), `surplus` (the early stop on a surplus of negative eigenvalues),
 //! `solve` (solves and refinement), `backend` ([`StructuredKkt`], the pounce interface),
-//! `pool` (workspaces kept across solves) and `counters` (process-wide diagnostics).
+//! `pool` (the planner's [`KktCache`]: workspaces kept across solves) and `counters` (its
+//! factorisations counted, for diagnostics).
 //!
 //! [`Transcription`]: super::transcription::Transcription
 //! [`FeralSolverInterface`]: pounce_feral::FeralSolverInterface
@@ -72,11 +73,8 @@ mod tests;
 mod workspace;
 
 pub use backend::{KktSolver, StructuredKkt};
-pub use counters::{
-    block_factorizations_total, feral_fallbacks_total, plain_factorizations_total,
-    surplus_stops_total,
-};
+pub use counters::KktCounts;
 pub use labels::KktLabels;
-pub use pool::{clear_workspace_pool, workspace_reuses_total};
+pub use pool::KktCache;
 
 use workspace::Workspace;

@@ -22,7 +22,7 @@ use pounce_rs::{
     IpoptData, IterStats, NlpInfo, Solution, SparsityRequest, StartingPoint, TNLP,
 };
 
-use super::kkt::{KktLabels, KktSolver, StructuredKkt};
+use super::kkt::{KktCache, KktLabels, KktSolver, StructuredKkt};
 use super::transcription::Transcription;
 use crate::clock::Deadline;
 
@@ -580,6 +580,7 @@ fn application(
     warm: bool,
     budget: Duration,
     labels: Option<KktLabels>,
+    kkt: &Arc<KktCache>,
 ) -> Result<IpoptApplication, OptionError> {
     let mut app = IpoptApplication::new();
     let _ = app.initialize();
@@ -673,7 +674,7 @@ fn application(
     set_extra_options(o, &settings.extra)?;
     install_restoration(&mut app);
     if settings.kkt == KktSolver::Structured {
-        install_structured_kkt(&mut app, labels);
+        install_structured_kkt(&mut app, labels, Arc::clone(kkt));
     }
     Ok(app)
 }
@@ -702,7 +703,11 @@ fn set_extra_options(o: &mut OptionsList, extra: &[(String, String)]) -> Result<
 /// Plugs the structured KKT backend into `app`'s main algorithm, falling back to FERAL
 /// configured exactly as pounce's default backend would be (the same options). Call after
 /// setting options.
-fn install_structured_kkt(app: &mut IpoptApplication, labels: Option<KktLabels>) {
+fn install_structured_kkt(
+    app: &mut IpoptApplication,
+    labels: Option<KktLabels>,
+    cache: Arc<KktCache>,
+) {
     use pounce_feral::FeralSolverInterface;
     use pounce_linsol::SparseSymLinearSolverInterface;
     use pounce_rs::pounce_algorithm::alg_builder::LinearSolverChoice;
@@ -711,9 +716,11 @@ fn install_structured_kkt(app: &mut IpoptApplication, labels: Option<KktLabels>)
     app.set_linear_backend_factory(Box::new(
         move |choice| -> Box<dyn SparseSymLinearSolverInterface> {
             match choice {
-                LinearSolverChoice::Feral => {
-                    Box::new(StructuredKkt::new(labels.clone(), feral_cfg.clone()))
-                }
+                LinearSolverChoice::Feral => Box::new(StructuredKkt::new(
+                    labels.clone(),
+                    feral_cfg.clone(),
+                    Arc::clone(&cache),
+                )),
                 // Not asked for by these settings; pounce's own answer without MA57.
                 LinearSolverChoice::Ma57 => {
                     Box::new(FeralSolverInterface::with_config(feral_cfg.clone()))
@@ -724,20 +731,22 @@ fn install_structured_kkt(app: &mut IpoptApplication, labels: Option<KktLabels>)
 }
 
 /// Solves `tr` from the scaled start `start` (with its duals when `warm_start`), stopping
-/// within `budget`. Returns the transcription back with the outcome.
+/// within `budget`, the structured backend's workspaces pooled in `kkt` (the planner's).
+/// Returns the transcription back with the outcome.
 pub fn solve(
     tr: Transcription,
     start: PrimalDual,
     warm_start: bool,
     settings: &NlpSettings,
     budget: SolveBudget,
+    kkt: &Arc<KktCache>,
 ) -> Result<(Transcription, NlpOutcome), OptionError> {
     let deadline = budget.deadline;
     let clock = deadline.clock();
     let began = clock.now();
     let n = tr.n_vars();
     let labels = (settings.kkt == KktSolver::Structured).then(|| KktLabels::of(&tr));
-    let mut app = application(settings, warm_start, deadline.remaining(), labels)?;
+    let mut app = application(settings, warm_start, deadline.remaining(), labels, kkt)?;
     let adapter = Rc::new(RefCell::new(Adapter {
         tr,
         start,

@@ -6,10 +6,11 @@ use pounce_feral::{FeralConfig, FeralSolverInterface};
 use pounce_linsol::FactorPattern;
 use pounce_linsol::{EMatrixFormat, ESymSolverStatus, SparseSymLinearSolverInterface};
 use pounce_rs::{Index, Number};
+use std::sync::Arc;
 
-use super::counters::{BLOCK_FACTORIZATIONS, FERAL_FALLBACKS, PLAIN_FACTORIZATIONS, SURPLUS_STOPS};
+use super::counters::KktCounters;
 use super::factor::Count;
-use super::{KktLabels, Workspace, pool};
+use super::{KktCache, KktLabels, Workspace, pool};
 
 /// Which linear solver factors the KKT systems of the NLP solves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -34,6 +35,8 @@ enum Factored {
 /// The structured KKT backend (see the module documentation).
 pub struct StructuredKkt {
     labels: Option<KktLabels>,
+    /// The planner's pool of workspaces and its counters.
+    cache: Arc<KktCache>,
     feral: FeralSolverInterface,
     /// `None`: every factorisation goes to FERAL (the labels did not fit the pattern).
     pub(super) ws: Option<Workspace>,
@@ -59,10 +62,16 @@ pub struct StructuredKkt {
 
 impl StructuredKkt {
     /// A backend for KKTs labelled `labels` (`None`: FERAL for every matrix), falling back
-    /// to FERAL configured with `feral`.
-    pub fn new(labels: Option<KktLabels>, feral: FeralConfig) -> StructuredKkt {
+    /// to FERAL configured with `feral`, its workspaces pooled and its factorisations
+    /// counted in `cache`.
+    pub fn new(
+        labels: Option<KktLabels>,
+        feral: FeralConfig,
+        cache: Arc<KktCache>,
+    ) -> StructuredKkt {
         StructuredKkt {
             labels,
+            cache,
             feral: FeralSolverInterface::with_config(feral),
             ws: None,
             plain: None,
@@ -84,7 +93,8 @@ impl StructuredKkt {
     fn release(&mut self) {
         let plain = self.plain.take();
         if let (Some(ws), Some(labels)) = (self.ws.take(), self.labels.as_ref()) {
-            pool::give_back(pool::Pooled::new(labels.clone(), ws, plain));
+            self.cache
+                .give_back(pool::Pooled::new(labels.clone(), ws, plain));
         }
     }
 
@@ -143,7 +153,7 @@ impl SparseSymLinearSolverInterface for StructuredKkt {
         if let Some(l) = self.labels.as_ref() {
             // A workspace is a function of the pattern and the labels alone: one built
             // for this very pattern factors as a new one would (see `pool`).
-            if let Some(p) = pool::take(self.dim, ia, ja, l) {
+            if let Some(p) = self.cache.take(self.dim, ia, ja, l) {
                 self.ws = Some(p.ws);
                 self.plain = p.plain;
                 self.reused = true;
@@ -211,19 +221,19 @@ impl SparseSymLinearSolverInterface for StructuredKkt {
                     neg = plain.factor(&self.values, self.floor, test);
                     self.on_plain = neg.is_some();
                     if self.on_plain {
-                        PLAIN_FACTORIZATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        KktCounters::bump(&self.cache.counters.plain);
                     }
                 }
             }
             let Some(neg) = neg else {
-                FERAL_FALLBACKS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                KktCounters::bump(&self.cache.counters.feral_fallbacks);
                 return self.feral_solve(true, ia, ja, nrhs, rhs_vals, check, expected);
             };
             self.block_factorizations += 1;
-            BLOCK_FACTORIZATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            KktCounters::bump(&self.cache.counters.block);
             match neg {
                 Count::Surplus => {
-                    SURPLUS_STOPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    KktCounters::bump(&self.cache.counters.surplus_stops);
                     self.surplus_stops += 1;
                     self.factored = Factored::Stopped;
                     // More than expected (pounce reads only which side of it the count

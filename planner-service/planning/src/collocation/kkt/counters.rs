@@ -1,42 +1,49 @@
-//! Process-wide counters of the structured factorisations (diagnostics and tests).
+//! Counters of the structured factorisations of one planner's solves (diagnostics and
+//! tests), kept in its [`super::KktCache`].
 
-/// Factorisations done by block elimination, over the process (diagnostics and tests).
-pub(super) static BLOCK_FACTORIZATIONS: std::sync::atomic::AtomicUsize =
-    std::sync::atomic::AtomicUsize::new(0);
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Factorisations of labelled matrices that block elimination handed to FERAL (a pivot
-/// under the floor, a non-finite entry), over the process.
-pub(super) static FERAL_FALLBACKS: std::sync::atomic::AtomicUsize =
-    std::sync::atomic::AtomicUsize::new(0);
-
-/// Factorisations block elimination stopped early on a certain surplus of negative
-/// eigenvalues (see [`super::Workspace::surplus`]), over the process.
-pub(super) static SURPLUS_STOPS: std::sync::atomic::AtomicUsize =
-    std::sync::atomic::AtomicUsize::new(0);
-
-/// How many factorisations block elimination stopped early on a surplus of negative
-/// eigenvalues in this process (included in [`block_factorizations_total`]).
-pub fn surplus_stops_total() -> usize {
-    SURPLUS_STOPS.load(std::sync::atomic::Ordering::Relaxed)
+/// The counters, updated by the solves' backends.
+#[derive(Debug, Default)]
+pub(super) struct KktCounters {
+    /// Factorisations done by block elimination.
+    pub block: AtomicUsize,
+    /// Factorisations of labelled matrices that block elimination handed to FERAL (a
+    /// pivot under the floor, a non-finite entry).
+    pub feral_fallbacks: AtomicUsize,
+    /// Factorisations block elimination stopped early on a certain surplus of negative
+    /// eigenvalues (see [`super::Workspace::surplus`]; included in `block`).
+    pub surplus_stops: AtomicUsize,
+    /// Factorisations by block elimination without the pivot groups (their pivots
+    /// refused; included in `block`).
+    pub plain: AtomicUsize,
 }
 
-/// How many KKT factorisations block elimination has done in this process.
-pub fn block_factorizations_total() -> usize {
-    BLOCK_FACTORIZATIONS.load(std::sync::atomic::Ordering::Relaxed)
+/// The counters at one moment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct KktCounts {
+    /// Factorisations done by block elimination.
+    pub block_factorizations: usize,
+    /// Of those, stopped early on a surplus of negative eigenvalues.
+    pub surplus_stops: usize,
+    /// Of those, done without the pivot groups.
+    pub plain_factorizations: usize,
+    /// Factorisations of matrices the labels fit that went to FERAL.
+    pub feral_fallbacks: usize,
 }
 
-/// Factorisations by block elimination without the pivot groups (their pivots refused),
-/// over the process.
-pub(super) static PLAIN_FACTORIZATIONS: std::sync::atomic::AtomicUsize =
-    std::sync::atomic::AtomicUsize::new(0);
+impl KktCounters {
+    /// Adds one to `counter`.
+    pub fn bump(counter: &AtomicUsize) {
+        counter.fetch_add(1, Ordering::Relaxed);
+    }
 
-/// How many factorisations block elimination did without the pivot groups in this
-/// process (included in [`block_factorizations_total`]).
-pub fn plain_factorizations_total() -> usize {
-    PLAIN_FACTORIZATIONS.load(std::sync::atomic::Ordering::Relaxed)
-}
-
-/// How many factorisations of matrices the labels fit went to FERAL in this process.
-pub fn feral_fallbacks_total() -> usize {
-    FERAL_FALLBACKS.load(std::sync::atomic::Ordering::Relaxed)
+    pub fn snapshot(&self) -> KktCounts {
+        KktCounts {
+            block_factorizations: self.block.load(Ordering::Relaxed),
+            surplus_stops: self.surplus_stops.load(Ordering::Relaxed),
+            plain_factorizations: self.plain.load(Ordering::Relaxed),
+            feral_fallbacks: self.feral_fallbacks.load(Ordering::Relaxed),
+        }
+    }
 }

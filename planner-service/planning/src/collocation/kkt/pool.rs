@@ -11,14 +11,16 @@
 //! (`a_reused_workspace_factors_as_a_fresh_one`), so a solve that takes one from here
 //! computes the same bits as with a new one.
 //!
-//! The pool is process-wide (the planner's solver threads are created per plan) and
-//! bounded by [`POOL_BYTES`]: the least recently returned workspace goes first.
+//! The pool belongs to the planner that owns its [`KktCache`] (the solves of its plans
+//! share it across their threads and across plans) and is bounded by [`POOL_BYTES`]: the
+//! least recently returned workspace goes first.
 
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use pounce_rs::Index;
 
+use super::counters::KktCounters;
 use super::{KktLabels, Workspace};
 
 /// Most bytes of buffers the pool keeps: about one 3-D plan's workspaces (25-30 MB over
@@ -50,42 +52,67 @@ impl Pooled {
     }
 }
 
-/// Least recently returned first.
-static POOL: Mutex<Vec<Pooled>> = Mutex::new(Vec::new());
-
-/// Workspaces taken from the pool instead of built, over the process.
-static REUSES: AtomicUsize = AtomicUsize::new(0);
-
-/// How many solves in this process took their KKT workspace from the pool.
-pub fn workspace_reuses_total() -> usize {
-    REUSES.load(Ordering::Relaxed)
+/// What the structured backend keeps across the solves of one planner: the pool of KKT
+/// workspaces, and the counters of its factorisations. A planner owns one and hands it to
+/// every solve (`collocation::solve`); a solve without a planner makes its own.
+#[derive(Default)]
+pub struct KktCache {
+    /// Least recently returned first.
+    pool: Mutex<Vec<Pooled>>,
+    /// Workspaces taken from the pool instead of built.
+    reuses: AtomicUsize,
+    /// The factorisations' counters.
+    pub(super) counters: KktCounters,
 }
 
-/// Drops every pooled workspace (benchmarks count the heap from an empty pool).
-pub fn clear_workspace_pool() {
-    pool().clear();
-}
+impl KktCache {
+    /// An empty cache.
+    pub fn new() -> KktCache {
+        KktCache::default()
+    }
 
-fn pool() -> std::sync::MutexGuard<'static, Vec<Pooled>> {
-    // Nothing panics under the lock; recover anyway (the pool is only a cache).
-    POOL.lock().unwrap_or_else(|e| e.into_inner())
-}
+    /// How many solves took their KKT workspace from the pool.
+    pub fn workspace_reuses(&self) -> usize {
+        self.reuses.load(Ordering::Relaxed)
+    }
 
-/// The pooled workspace built for exactly this pattern and these labels, if any.
-pub(super) fn take(dim: usize, ia: &[Index], ja: &[Index], labels: &KktLabels) -> Option<Pooled> {
-    let mut pool = pool();
-    let i = pool.iter().rposition(|p| p.fits(dim, ia, ja, labels))?;
-    REUSES.fetch_add(1, Ordering::Relaxed);
-    Some(pool.remove(i))
-}
+    /// Drops every pooled workspace (benchmarks count the heap from an empty pool).
+    pub fn clear_workspace_pool(&self) {
+        self.pool().clear();
+    }
 
-/// Keeps `p` for a later solve, dropping the least recently returned workspaces beyond
-/// [`POOL_BYTES`].
-pub(super) fn give_back(p: Pooled) {
-    let mut pool = pool();
-    pool.push(p);
-    let mut total: usize = pool.iter().map(|p| p.bytes).sum();
-    while total > POOL_BYTES && !pool.is_empty() {
-        total -= pool.remove(0).bytes;
+    /// The factorisations counted so far.
+    pub fn counts(&self) -> super::KktCounts {
+        self.counters.snapshot()
+    }
+
+    fn pool(&self) -> std::sync::MutexGuard<'_, Vec<Pooled>> {
+        // Nothing panics under the lock; recover anyway (the pool is only a cache).
+        self.pool.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The pooled workspace built for exactly this pattern and these labels, if any.
+    pub(super) fn take(
+        &self,
+        dim: usize,
+        ia: &[Index],
+        ja: &[Index],
+        labels: &KktLabels,
+    ) -> Option<Pooled> {
+        let mut pool = self.pool();
+        let i = pool.iter().rposition(|p| p.fits(dim, ia, ja, labels))?;
+        self.reuses.fetch_add(1, Ordering::Relaxed);
+        Some(pool.remove(i))
+    }
+
+    /// Keeps `p` for a later solve, dropping the least recently returned workspaces beyond
+    /// [`POOL_BYTES`].
+    pub(super) fn give_back(&self, p: Pooled) {
+        let mut pool = self.pool();
+        pool.push(p);
+        let mut total: usize = pool.iter().map(|p| p.bytes).sum();
+        while total > POOL_BYTES && !pool.is_empty() {
+            total -= pool.remove(0).bytes;
+        }
     }
 }

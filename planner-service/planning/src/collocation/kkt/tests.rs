@@ -4,6 +4,8 @@ use pounce_feral::FeralConfig;
 use pounce_linsol::{ESymSolverStatus, SparseSymLinearSolverInterface};
 use pounce_rs::Index;
 
+use std::sync::Arc;
+
 use super::*;
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use rand::{RngExt, SeedableRng};
@@ -100,6 +102,11 @@ fn arrowhead(sizes: &[usize], nb: usize, chain: bool, rng: &mut ChaCha8Rng) -> A
     }
 }
 
+/// A cache of its own (no other test's workspaces).
+fn fresh_cache() -> Arc<KktCache> {
+    Arc::new(KktCache::new())
+}
+
 fn feral_cfg() -> FeralConfig {
     FeralConfig::default()
 }
@@ -193,7 +200,7 @@ fn pivot_groups_match_a_dense_solve_and_the_eigenvalues() {
             blocks: a.labels.clone(),
             groups,
         };
-        let mut solver = StructuredKkt::new(Some(labels), feral_cfg());
+        let mut solver = StructuredKkt::new(Some(labels), feral_cfg(), fresh_cache());
         let status = solve_with(&mut solver, &a.ia, &a.ja, &a.va, &mut x, nrhs, Some(neg));
         assert_eq!(status, ESymSolverStatus::Success);
         let ws = solver.ws.as_ref().expect("the labels fit");
@@ -248,13 +255,13 @@ fn a_reused_workspace_factors_as_a_fresh_one() {
             .map(|v| v * rng.random_range(-1.5..1.5))
             .collect();
     let b: Vec<f64> = (0..dim).map(|_| rng.random_range(-1.0..1.0)).collect();
-    let mut used = StructuredKkt::new(Some(labels.clone()), feral_cfg());
+    let mut used = StructuredKkt::new(Some(labels.clone()), feral_cfg(), fresh_cache());
     let mut x_used = b.clone();
     let _ = solve_with(&mut used, &a.ia, &a.ja, &a.va, &mut x_used, 1, None);
     let mut x_used = b.clone();
     used.values_array_mut().copy_from_slice(&second);
     let status = used.multi_solve(true, &a.ia, &a.ja, 1, &mut x_used, false, 0);
-    let mut fresh = StructuredKkt::new(Some(labels), feral_cfg());
+    let mut fresh = StructuredKkt::new(Some(labels), feral_cfg(), fresh_cache());
     let mut x_fresh = b.clone();
     let status_fresh = solve_with(&mut fresh, &a.ia, &a.ja, &second, &mut x_fresh, 1, None);
     assert_eq!(status, status_fresh);
@@ -300,12 +307,14 @@ fn a_pooled_workspace_solves_as_a_new_one() {
             .map(|v| v * rng.random_range(-1.5..1.5))
             .collect();
     let b: Vec<f64> = (0..dim).map(|_| rng.random_range(-1.0..1.0)).collect();
-    let mut first = StructuredKkt::new(Some(labels.clone()), feral_cfg());
+    // One planner's cache, shared by its solves.
+    let cache = Arc::new(KktCache::new());
+    let mut first = StructuredKkt::new(Some(labels.clone()), feral_cfg(), Arc::clone(&cache));
     let mut x = b.clone();
     let _ = solve_with(&mut first, &a.ia, &a.ja, &a.va, &mut x, 1, None);
     assert!(first.is_structured() && !first.reused);
     drop(first);
-    let mut pooled = StructuredKkt::new(Some(labels.clone()), feral_cfg());
+    let mut pooled = StructuredKkt::new(Some(labels.clone()), feral_cfg(), Arc::clone(&cache));
     let mut x_pooled = b.clone();
     let status = solve_with(&mut pooled, &a.ia, &a.ja, &values, &mut x_pooled, 1, None);
     assert!(
@@ -313,7 +322,7 @@ fn a_pooled_workspace_solves_as_a_new_one() {
         "the finished solve's workspace was not taken"
     );
     // The pooled one is in use: this one is built.
-    let mut built = StructuredKkt::new(Some(labels.clone()), feral_cfg());
+    let mut built = StructuredKkt::new(Some(labels.clone()), feral_cfg(), Arc::clone(&cache));
     let mut x_built = b.clone();
     let status_built = solve_with(&mut built, &a.ia, &a.ja, &values, &mut x_built, 1, None);
     assert!(!built.reused);
@@ -326,7 +335,7 @@ fn a_pooled_workspace_solves_as_a_new_one() {
     drop(built);
     // Another pattern: the last entry dropped.
     let n = a.ia.len() - 1;
-    let mut other = StructuredKkt::new(Some(labels), feral_cfg());
+    let mut other = StructuredKkt::new(Some(labels.clone()), feral_cfg(), Arc::clone(&cache));
     let mut x_other = b.clone();
     let _ = solve_with(
         &mut other,
@@ -338,6 +347,28 @@ fn a_pooled_workspace_solves_as_a_new_one() {
         None,
     );
     assert!(!other.reused, "a workspace of another pattern was taken");
+    assert_eq!(
+        cache.workspace_reuses(),
+        1,
+        "the cache counts its one reuse"
+    );
+    // Another planner's cache holds nothing of this one's.
+    drop(other);
+    let mut elsewhere = StructuredKkt::new(Some(labels), feral_cfg(), Arc::new(KktCache::new()));
+    let mut x_elsewhere = b.clone();
+    let _ = solve_with(
+        &mut elsewhere,
+        &a.ia,
+        &a.ja,
+        &values,
+        &mut x_elsewhere,
+        1,
+        None,
+    );
+    assert!(
+        !elsewhere.reused,
+        "a workspace of another planner's cache was taken"
+    );
 }
 
 /// Two groups coupled to each other do not fit: FERAL factors that matrix.
@@ -358,7 +389,7 @@ fn coupled_groups_go_to_feral() {
         blocks: a.labels.clone(),
         groups,
     };
-    let mut solver = StructuredKkt::new(Some(labels), feral_cfg());
+    let mut solver = StructuredKkt::new(Some(labels), feral_cfg(), fresh_cache());
     let _ = solve_with(&mut solver, &a.ia, &a.ja, &a.va, &mut x, 1, None);
     assert!(!solver.is_structured());
     assert_eq!(solver.feral_factorizations, 1);
@@ -415,7 +446,11 @@ fn a_surplus_stops_only_when_the_rest_cannot_make_up_for_it() {
             ja.push(1);
             va.push(1.0);
         }
-        let mut solver = StructuredKkt::new(Some(KktLabels::plain(vec![0, 1, 1])), feral_cfg());
+        let mut solver = StructuredKkt::new(
+            Some(KktLabels::plain(vec![0, 1, 1])),
+            feral_cfg(),
+            fresh_cache(),
+        );
         let mut x = vec![1.0; 3];
         let got = solve_with(&mut solver, &ia, &ja, &va, &mut x, 1, Some(1));
         assert!(solver.is_structured());
@@ -462,7 +497,8 @@ fn arrowhead_matches_a_dense_solve_and_the_eigenvalues() {
             .map(|_| rng.random_range(-1.0..1.0))
             .collect();
         let mut x = b.clone();
-        let mut solver = StructuredKkt::new(Some(KktLabels::plain(labels)), feral_cfg());
+        let mut solver =
+            StructuredKkt::new(Some(KktLabels::plain(labels)), feral_cfg(), fresh_cache());
         let status = solve_with(&mut solver, &ia, &ja, &va, &mut x, nrhs, Some(neg));
         assert_eq!(status, ESymSolverStatus::Success);
         assert!(solver.is_structured());
@@ -515,7 +551,8 @@ fn a_pattern_coupling_two_blocks_goes_to_feral() {
         .unwrap();
     for labels in [labels.clone(), labels[1..].to_vec()] {
         let mut x = b.clone();
-        let mut solver = StructuredKkt::new(Some(KktLabels::plain(labels)), feral_cfg());
+        let mut solver =
+            StructuredKkt::new(Some(KktLabels::plain(labels)), feral_cfg(), fresh_cache());
         let status = solve_with(&mut solver, &ia, &ja, &va, &mut x, 1, None);
         assert_eq!(status, ESymSolverStatus::Success);
         assert!(!solver.is_structured());
@@ -537,7 +574,11 @@ fn a_singular_block_goes_to_feral() {
     let ja = [1, 3, 1, 3, 4];
     let va = [2.0, -1.0, 0.5, 0.3, 4.0];
     let mut x = vec![1.0; 4];
-    let mut solver = StructuredKkt::new(Some(KktLabels::plain(vec![0, 0, 1, -1])), feral_cfg());
+    let mut solver = StructuredKkt::new(
+        Some(KktLabels::plain(vec![0, 0, 1, -1])),
+        feral_cfg(),
+        fresh_cache(),
+    );
     let status = solve_with(&mut solver, &ia, &ja, &va, &mut x, 1, None);
     assert!(solver.is_structured());
     assert_eq!(
