@@ -193,7 +193,7 @@ fn a_failed_first_plan_is_tried_again() {
     assert_eq!(s.state(), Some(PlannerState::Degraded));
     // After the retry wait, the next pass starts another attempt.
     std::thread::sleep(
-        wingman_planner::service::run::FIRST_PLAN_RETRY + Duration::from_millis(100),
+        wingman_planner::service::message_loop::FIRST_PLAN_RETRY + Duration::from_millis(100),
     );
     d.pass();
     assert_eq!(

@@ -1,0 +1,166 @@
+//! Taking a finished plan: publishing it and making it current (its moving threats'
+//! scheduled re-plans, the ids and sequences), or after a failed first plan scheduling
+//! the retry; then checking the threats reported while it was computed against it.
+
+use tracing::{error, info, warn};
+use wingman_interfaces::{Header, SENDER_PLANNER, Trigger};
+
+use super::lifecycle::{FirstPlan, PlanLifecycle};
+use super::{FIRST_PLAN_RETRY, MessageLoop};
+use crate::service::solver::{SolveResult, Ticket};
+use crate::service::world::{self, ThreatSlot};
+use wingman_planning::hybrid::PlanOutcome;
+use wingman_planning::plan_message::{self as export, PlanInfo};
+
+impl MessageLoop {
+    /// Takes the solve thread's result: the plan computed is done (its follow-up, if any,
+    /// is triggered).
+    pub(super) fn on_result(&mut self, result: SolveResult) {
+        let SolveResult {
+            problem,
+            ticket,
+            outcome,
+            started,
+            finished,
+            core_time,
+        } = result;
+        self.lifecycle.plan_done();
+        self.problem = Some(problem);
+        self.gate.record(started, finished, core_time);
+        let compute_ms = finished.saturating_sub(started).as_secs_f64() * 1e3;
+        self.counters.last_compute_ms = compute_ms;
+        match outcome {
+            Ok(o) => self.accept(&o, &ticket, compute_ms),
+            Err(e) => {
+                warn!(trigger = ticket.trigger.name(), error = %e, "no plan made");
+                // Without a plan the status says `Degraded`; the first plan is tried again
+                // (the compute gate spaces the attempts), and a new tasking or route is
+                // taken into the next attempt.
+                if !self.has_plan {
+                    self.first = FirstPlan::RetryAfterFailure {
+                        at: self.clock.now() + FIRST_PLAN_RETRY,
+                    };
+                }
+            }
+        }
+        // Threats that changed while the plan was computed are not in it: check each
+        // against the plan now current (a pop-up clear of the old plan may lie on the new
+        // one). Pending pop-ups that the new plan already avoids need no follow-up.
+        if self.has_plan && self.world.epoch > ticket.epoch {
+            let touch = self.popups_touch(ticket.epoch);
+            let pending = self.lifecycle.pending();
+            if pending.only_popups() && !touch {
+                info!("pop-ups during the plan are clear of it: no follow-up");
+                self.lifecycle = PlanLifecycle::Idle;
+            } else if touch && pending.is_empty() {
+                info!("a threat reported during the plan reaches it: re-plan");
+                self.raise(Trigger::PopUp);
+            }
+        }
+    }
+
+    /// Whether any threat changed after `epoch` reaches the current plan.
+    fn popups_touch(&self, epoch: u64) -> bool {
+        let mut touches = false;
+        for i in 0..world::MAX_STATIC_THREATS {
+            if let Some(s) = self.world.static_threat(i)
+                && s.epoch > epoch
+            {
+                touches |= self
+                    .assess_popup(ThreatSlot::Static(i))
+                    .is_none_or(|a| a.touches());
+            }
+        }
+        for (i, m) in self.world.movings() {
+            if m.epoch > epoch {
+                touches |= self
+                    .assess_popup(ThreatSlot::Moving(i))
+                    .is_none_or(|a| a.touches());
+            }
+        }
+        touches
+    }
+
+    /// Publishes a plan made by the solver and makes it current.
+    fn accept(&mut self, o: &PlanOutcome, ticket: &Ticket, compute_ms: f64) {
+        // The model and speed of the problem planned (the tasking may have changed since).
+        let Some((model, speed)) = self.problem.as_ref().map(|p| (p.model, p.limits.speed)) else {
+            error!(
+                trigger = ticket.trigger.name(),
+                "the problem buffers are missing: the plan made is dropped"
+            );
+            return;
+        };
+        let info = PlanInfo {
+            plan_id: self.next_plan_id,
+            trigger: ticket.trigger,
+            quality: o.quality,
+            model,
+            created_at_s: ticket.created_at_s,
+            cost: o.cost,
+            compute_ms,
+        };
+        let header = Header::new(
+            SENDER_PLANNER,
+            self.plan_sequence + 1,
+            self.world.now_ns.max(0),
+        );
+        if let Err(e) = export::write_plan(&mut self.scratch, header, &info, &o.trajectory) {
+            error!(error = %e, "the plan cannot be exported; it is dropped");
+            return;
+        }
+        // Scheduled re-plans of the moving threats over the new plan.
+        self.points.fill(&self.scratch, speed);
+        std::mem::swap(&mut self.current, &mut self.scratch);
+        self.has_plan = true;
+        let slots: [Option<usize>; world::MAX_MOVING_THREATS] = {
+            let mut s = [None; world::MAX_MOVING_THREATS];
+            for (k, (i, _)) in self.world.movings().enumerate() {
+                s[k] = Some(i);
+            }
+            s
+        };
+        for i in slots.into_iter().flatten() {
+            self.schedule(i);
+        }
+        export::set_next_replan(&mut self.current, self.world.next_replan());
+        self.awaiting_start = None;
+        self.plan_revision = ticket.tasking_revision;
+        self.plan_targets_from = ticket.targets_from;
+        self.publish_plan();
+        self.plan_sequence += 1;
+        match self.next_plan_id.checked_add(1) {
+            Some(n) => self.next_plan_id = n,
+            None => error!("plan ids exhausted: the next plan repeats the id"),
+        }
+        self.counters.plans += 1;
+        info!(
+            plan_id = self.current.plan_id,
+            trigger = ticket.trigger.name(),
+            quality = o.quality.name(),
+            start_s = self.current.start_time_s,
+            valid_until_s = self.current.valid_until_s,
+            samples = self.current.sample_count,
+            next_replan_s = self.current.next_replan(),
+            "plan published"
+        );
+    }
+
+    fn publish_plan(&mut self) {
+        match self.ports.plan.loan_uninit() {
+            Ok(mut sample) => {
+                let slot = sample.payload_mut();
+                // SAFETY: `current` is a valid `Plan` and the loaned slot holds room for one;
+                // the copy goes memory to memory (160 KiB never cross the stack).
+                let sample = unsafe {
+                    std::ptr::copy_nonoverlapping(&*self.current, slot.as_mut_ptr(), 1);
+                    sample.assume_init()
+                };
+                if let Err(e) = sample.send() {
+                    error!(error = ?e, "cannot send the plan");
+                }
+            }
+            Err(e) => error!(error = ?e, "cannot loan a plan sample"),
+        }
+    }
+}
