@@ -8,7 +8,7 @@
 
 use wingman_interfaces::{Model, OWNSHIP_HOLDING, OwnshipState, Plan, Wire};
 use wingman_planning::dynamics::{
-    DynamicsError, G0, Planar, Spatial, VehicleLimits, rk4_step_with, wrap_angle,
+    DynamicsError, G0, Limits, Planar, Spatial, rk4_step_with, wrap_angle,
 };
 use wingman_planning::problem::Problem;
 use wingman_planning::tracking::{Deviation, Tracker, TrackingGains};
@@ -62,7 +62,7 @@ enum Vehicle {
 #[derive(Debug, Clone)]
 pub struct InnerLoop {
     model: Model,
-    limits: VehicleLimits,
+    limits: Limits,
     tracker: Tracker,
     vehicle: Vehicle,
     t: f64,
@@ -337,7 +337,7 @@ pub fn reference(plan: &Plan, t: f64) -> ([f64; 7], [f64; 2]) {
 /// The safe hold: a level turn to the left. 2-D: half the turn-rate limit. 3-D: bank
 /// [`HOLD_BANK_RAD`] (at most half the bank limit), flight-path angle driven to zero (up
 /// when near the altitude floor), the load factor that holds the turn level.
-pub fn hold_control(model: Model, l: &VehicleLimits, x: &[f64; 7]) -> [f64; 2] {
+pub fn hold_control(model: Model, l: &Limits, x: &[f64; 7]) -> [f64; 2] {
     match model {
         Model::TwoD => [0.5 * l.turn_rate_max, 0.0],
         Model::ThreeD => {

@@ -139,13 +139,14 @@ fn finite(field: &'static str, value: f64) -> Result<f64, DynamicsError> {
     }
 }
 
-/// Vehicle limits in SI units and radians (FORMULATION.md §2, scenario `[vehicle]`).
+/// The vehicle limits in SI units and radians, as the models use them (FORMULATION.md §2,
+/// scenario `[vehicle]`; the tasking carries them as `wingman_interfaces::VehicleLimits`).
 ///
 /// The 2-D model uses `speed` and `turn_rate_max`; the 3-D model uses the others. Limits a
-/// model does not use are infinite when built by [`VehicleLimits::planar`] or
-/// [`VehicleLimits::spatial`], so a bound check on them never fires.
+/// model does not use are infinite when built by [`Limits::planar`] or
+/// [`Limits::spatial`], so a bound check on them never fires.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct VehicleLimits {
+pub struct Limits {
     /// Constant airspeed `V`, m/s.
     pub speed: f64,
     /// 2-D: bound on `|u| = |psi'|`, rad/s.
@@ -166,7 +167,7 @@ pub struct VehicleLimits {
     pub z_min: f64,
 }
 
-/// The 3-D part of [`VehicleLimits`], for [`VehicleLimits::spatial`].
+/// The 3-D part of [`Limits`], for [`Limits::spatial`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpatialLimits {
     /// Constant airspeed `V`, m/s.
@@ -187,7 +188,7 @@ pub struct SpatialLimits {
     pub z_min: f64,
 }
 
-impl VehicleLimits {
+impl Limits {
     /// Limits of the 2-D model; the 3-D limits are set to "unbounded".
     pub fn planar(speed: f64, turn_rate_max: f64) -> Result<Self, DynamicsError> {
         Ok(Self {

@@ -4,7 +4,7 @@
 //!
 //! All functions work on samples the caller owns and never allocate.
 
-use crate::dynamics::{Control2, Control3, State2, State3, VehicleLimits, idx2, idx3, wrap_angle};
+use crate::dynamics::{Control2, Control3, Limits, State2, State3, idx2, idx3, wrap_angle};
 use crate::estimation::{MovingThreat, exposure_at};
 use crate::threat::{Superquadric, ThreatLayout};
 
@@ -250,7 +250,7 @@ fn excess(v: f64, bound: f64) -> f64 {
 }
 
 /// Bound violations of 2-D controls.
-pub fn bound_violations_2d(controls: &[Control2], limits: &VehicleLimits) -> BoundViolations {
+pub fn bound_violations_2d(controls: &[Control2], limits: &Limits) -> BoundViolations {
     let umax = controls.iter().map(|u| u[0].abs()).fold(0.0, f64::max);
     BoundViolations {
         u: excess(umax, limits.turn_rate_max),
@@ -262,7 +262,7 @@ pub fn bound_violations_2d(controls: &[Control2], limits: &VehicleLimits) -> Bou
 pub fn bound_violations_3d(
     states: &[State3],
     controls: &[Control3],
-    limits: &VehicleLimits,
+    limits: &Limits,
 ) -> BoundViolations {
     let mut v = BoundViolations::default();
     for x in states {

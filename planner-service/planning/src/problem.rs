@@ -10,7 +10,7 @@
 
 use wingman_interfaces::{MAX_TARGETS, Model, Objective};
 
-use crate::dynamics::{self, SpatialLimits, VehicleLimits};
+use crate::dynamics::{self, Limits, SpatialLimits};
 use crate::estimation::{self, Estimate, GaussMarkov, MovingThreat, Road};
 use crate::lead::{LeadError, LeadPath};
 use crate::scenario::{MovingThreatSpec, Scenario, StaticThreatSpec};
@@ -70,7 +70,7 @@ pub enum Threats {
 pub struct Problem {
     pub model: Model,
     pub objective: Objective,
-    pub limits: VehicleLimits,
+    pub limits: Limits,
     pub weights: CostWeights,
     /// Start time.
     pub t0: f64,
@@ -304,10 +304,10 @@ impl Problem {
 pub fn vehicle_limits(
     model: Model,
     v: &wingman_interfaces::VehicleLimits,
-) -> Result<VehicleLimits, dynamics::DynamicsError> {
+) -> Result<Limits, dynamics::DynamicsError> {
     match model {
-        Model::TwoD => VehicleLimits::planar(v.speed_mps, v.turn_rate_max_rps),
-        Model::ThreeD => VehicleLimits::spatial(SpatialLimits {
+        Model::TwoD => Limits::planar(v.speed_mps, v.turn_rate_max_rps),
+        Model::ThreeD => Limits::spatial(SpatialLimits {
             speed: v.speed_mps,
             gamma_max: v.gamma_max_rad,
             nz_min: v.nz_min,

@@ -47,7 +47,7 @@ pub struct Tracker {
     three_d: bool,
     speed: f64,
     gains: TrackingGains,
-    limits: crate::dynamics::VehicleLimits,
+    limits: crate::dynamics::Limits,
 }
 
 impl Tracker {

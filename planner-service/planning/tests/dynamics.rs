@@ -9,8 +9,8 @@ use nalgebra::SMatrix;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use wingman_planning::dynamics::{
-    DynamicsError, G0, OdeModel, Planar, Reduced, ReducedPath, Spatial, SpatialLimits,
-    VehicleLimits, idx3, lift_reduced_path, rk4_integrate, rk4_step, rk4_trajectory,
+    DynamicsError, G0, Limits, OdeModel, Planar, Reduced, ReducedPath, Spatial, SpatialLimits,
+    idx3, lift_reduced_path, rk4_integrate, rk4_step, rk4_trajectory,
 };
 
 /// Largest entry of `|a - b|` over the largest entry of `|a|` (norm-wise relative error).
@@ -257,31 +257,31 @@ fn limits_are_validated() {
         mu_rate_max: 0.5,
         z_min: 500.0,
     };
-    let l = VehicleLimits::spatial(ok).unwrap();
+    let l = Limits::spatial(ok).unwrap();
     assert_eq!(l.turn_rate_max, f64::INFINITY);
     assert!(matches!(
-        VehicleLimits::spatial(SpatialLimits { nz_min: 1.0, ..ok }),
+        Limits::spatial(SpatialLimits { nz_min: 1.0, ..ok }),
         Err(DynamicsError::LevelFlightOutsideNz { .. })
     ));
     assert!(matches!(
-        VehicleLimits::spatial(SpatialLimits {
+        Limits::spatial(SpatialLimits {
             gamma_max: 1.6,
             ..ok
         }),
         Err(DynamicsError::AngleTooLarge { .. })
     ));
     assert!(matches!(
-        VehicleLimits::spatial(SpatialLimits { speed: -1.0, ..ok }),
+        Limits::spatial(SpatialLimits { speed: -1.0, ..ok }),
         Err(DynamicsError::NotPositive { field: "speed", .. })
     ));
     assert!(matches!(
-        VehicleLimits::spatial(SpatialLimits {
+        Limits::spatial(SpatialLimits {
             z_min: f64::NAN,
             ..ok
         }),
         Err(DynamicsError::NotFinite { .. })
     ));
-    assert!(VehicleLimits::planar(100.0, 0.0).is_err());
+    assert!(Limits::planar(100.0, 0.0).is_err());
     assert!(Planar::new(f64::INFINITY).is_err());
     assert!(Spatial::new(0.0).is_err());
     assert!(Reduced::new(-3.0).is_err());

@@ -5,7 +5,7 @@
 // Index loops over matrix and vector entries read like the formulas they check.
 #![allow(clippy::needless_range_loop)]
 
-use wingman_planning::dynamics::{SpatialLimits, VehicleLimits};
+use wingman_planning::dynamics::{Limits, SpatialLimits};
 use wingman_planning::estimation::{Estimate, GaussMarkov, MovingThreat, Road};
 use wingman_planning::metrics::{
     BoundViolations, TargetMiss, bound_violations_2d, bound_violations_3d, exposure_integral,
@@ -173,7 +173,7 @@ fn final_and_target_errors() {
 #[test]
 fn bound_violations_by_hand() {
     let deg = std::f64::consts::PI / 180.0;
-    let limits = VehicleLimits::spatial(SpatialLimits {
+    let limits = Limits::spatial(SpatialLimits {
         speed: 250.0,
         gamma_max: 30.0 * deg,
         nz_min: -1.0,
@@ -202,7 +202,7 @@ fn bound_violations_by_hand() {
         bound_violations_3d(&states[..0], &controls[..0], &limits),
         BoundViolations::default()
     );
-    let l2 = VehicleLimits::planar(100.0, 0.1).unwrap();
+    let l2 = Limits::planar(100.0, 0.1).unwrap();
     let v = bound_violations_2d(&[[0.05], [-0.13]], &l2);
     assert!((v.u - 0.03).abs() <= 1e-15 && v.z_min == 0.0);
 }

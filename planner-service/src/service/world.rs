@@ -16,7 +16,7 @@ use wingman_interfaces::{
 
 use super::triggers::{self, RouteDecision, TaskingDecision};
 use wingman_ipc::config::StalenessConfig;
-use wingman_planning::dynamics::{DynamicsError, VehicleLimits};
+use wingman_planning::dynamics::{DynamicsError, Limits};
 use wingman_planning::estimation::{
     Estimate, EstimationError, GaussMarkov, KalmanFilter, MovingThreat, Road,
 };
@@ -574,7 +574,7 @@ fn same_report(a: &ThreatReport, b: &ThreatReport) -> bool {
 /// A placeholder problem whose buffers hold a full plan's inputs, allocated once at
 /// start-up and refilled by [`World::fill_problem`] for every plan.
 pub fn reusable_problem() -> Problem {
-    let limits = VehicleLimits::planar(1.0, 1.0).expect("positive placeholder limits");
+    let limits = Limits::planar(1.0, 1.0).expect("positive placeholder limits");
     Problem {
         model: Model::TwoD,
         objective: Objective::MinTime,

@@ -10,7 +10,7 @@ use wingman_interfaces::{Model, OwnshipState, Plan, Tasking, Trigger};
 use super::MessageLoop;
 use crate::service::triggers::{self, TriggerSet};
 use crate::service::world::Splice;
-use wingman_planning::dynamics::{VehicleLimits, idx3};
+use wingman_planning::dynamics::{Limits, idx3};
 use wingman_planning::plan_message as export;
 
 /// Why a plan cannot start.
@@ -147,7 +147,7 @@ fn dead_reckon(o: &OwnshipState, t: &Tasking, at: f64) -> Option<[f64; 7]> {
             x[0] += v * cg * cc * dt;
             x[1] += v * cg * sc * dt;
             x[2] = (x[2] + v * sg * dt).max(l.altitude_min_m);
-            let limits = VehicleLimits {
+            let limits = Limits {
                 speed: v,
                 turn_rate_max: f64::INFINITY,
                 gamma_max: l.gamma_max_rad,
