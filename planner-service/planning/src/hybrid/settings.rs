@@ -1,0 +1,209 @@
+//! The planner's settings: each stage's, with their deployment defaults (why each default
+//! is what it is: `docs/decisions/`), and their check before a plan starts.
+
+use crate::collocation::{ExportSettings, NlpSettings, RefineSettings, TranscriptionSettings};
+use crate::swarm::{self, SwarmSettings};
+
+/// How each phase's first mesh is cut.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeshSettings {
+    /// LGR points per interval.
+    pub points: usize,
+    /// Target length of an interval of the first mesh.
+    pub interval_s: f64,
+    /// Fewest intervals in a phase.
+    pub min_intervals: usize,
+}
+
+impl Default for MeshSettings {
+    fn default() -> Self {
+        MeshSettings {
+            points: 6,
+            interval_s: 25.0,
+            min_intervals: 2,
+        }
+    }
+}
+
+/// Settings of the whole planner.
+#[derive(Debug, Clone)]
+pub struct PlannerSettings {
+    pub swarm: SwarmSettings,
+    pub mesh: MeshSettings,
+    pub transcription: TranscriptionSettings,
+    pub nlp: NlpSettings,
+    /// The NLP settings of the ranking solves on the coarse mesh (they only have to tell
+    /// the basins apart: looser tolerances).
+    pub ranking_nlp: NlpSettings,
+    /// The NLP settings of the finalists' solves on the working mesh.
+    pub finalist_nlp: NlpSettings,
+    pub refine: RefineSettings,
+    /// Refinement rounds after the first NLP solve.
+    pub refine_rounds: usize,
+    pub export: ExportSettings,
+    /// Largest share of the deadline the swarm may use.
+    pub swarm_share: f64,
+    /// NLP starts from distinct basins: the swarm's best and the best seeds that pass some
+    /// threat on another side (see `basins`).
+    pub starts: usize,
+    /// Threads solving the starts' NLPs side by side.
+    pub threads: usize,
+    /// The coarser mesh on which all starts are first ranked (2-D).
+    pub ranking_mesh: MeshSettings,
+    /// The ranking mesh of 3-D plans.
+    pub ranking_mesh_3d: MeshSettings,
+    /// The first barrier parameter of the 3-D ranking solves (`None`: `ranking_nlp`'s).
+    pub ranking_mu_init_3d: Option<f64>,
+    /// Largest scaled constraint violation of a ranking solve that still ranks.
+    pub ranking_feasibility_tol: f64,
+    /// How many of the best-ranked starts are solved again on the working mesh (at most).
+    pub finalists: usize,
+    /// A ranked start whose dense cost is within this of a finalist's (relative), on a path
+    /// not distinct from it ([`basins::separation`] under [`basins::MIN_SEPARATION_M`]),
+    /// reached the same basin: it is not solved again.
+    pub finalist_duplicate_tol: f64,
+    /// A ranked start whose dense cost is above the best's by more than this (relative)
+    /// is out of the race: it is not solved again.
+    pub finalist_gap_tol: f64,
+    /// Start the solves on the working and the refined meshes primal-dual from the
+    /// previous mesh's solution (multipliers carried over, see `collocation::warm`).
+    pub warm_mesh_changes: bool,
+    /// Split a finalist's working-mesh intervals where its ranked path crosses a threat's
+    /// edge (the exposure along an interval varying by more than this; phases before the
+    /// last; see [`split_crossings`]); `None`: no split.
+    pub crossing_split: Option<f64>,
+}
+
+/// The deployment defaults. Why each is what it is, with what was measured, is in
+/// `docs/decisions/` (the record named beside it).
+impl Default for PlannerSettings {
+    fn default() -> Self {
+        PlannerSettings {
+            swarm: SwarmSettings::default(),
+            mesh: MeshSettings::default(),
+            transcription: TranscriptionSettings::default(),
+            // The winner's refined solve: tol 1e-6 (0026), no second-order test (0013).
+            nlp: NlpSettings::default()
+                .with_feral_static_pivoting(true)
+                .with_tol(1e-6)
+                .with_second_order_check(false),
+            // Ranking only tells basins apart: stop at the first acceptable iterate
+            // (0008), no second-order test (0013) or corrections (0027).
+            ranking_nlp: NlpSettings::default()
+                .with_feral_static_pivoting(true)
+                .with_tol(1e-4)
+                .with_acceptable_tol(1e-3)
+                .with_acceptable_iter(1)
+                .with_acceptable_constr_viol_tol(Some(1e-3))
+                .with_second_order_check(false)
+                .with_second_order_corrections(false),
+            // A refined solve or a polish follows; feasible as the refined ones (0022).
+            finalist_nlp: NlpSettings::default()
+                .with_feral_static_pivoting(true)
+                .with_tol(1e-5)
+                .with_acceptable_tol(1e-4)
+                .with_acceptable_constr_viol_tol(Some(1e-7))
+                .with_constr_viol_tol(Some(1e-7)),
+            refine: RefineSettings::default(),
+            refine_rounds: 1, // more moved no cost, took 20-30 % of the plan (0011)
+            export: ExportSettings::default(),
+            swarm_share: 0.3,
+            starts: 5,  // six's worst cost, a 16 % shorter ranking; four lose basins (0021)
+            threads: 2, // the NLP tasks on two threads (0023)
+            // Coarser meshes lose basins; four points only in 3-D (0012).
+            ranking_mesh: MeshSettings {
+                points: 5,
+                interval_s: 35.0,
+                min_intervals: 2,
+            },
+            ranking_mesh_3d: MeshSettings {
+                points: 4,
+                interval_s: 35.0,
+                min_intervals: 2,
+            },
+            ranking_mu_init_3d: Some(1e-3), // 3-D starts are whole paths (0018)
+            ranking_feasibility_tol: 1e-3,  // as loose as the ranking's stop (0008)
+            // Two distinct finalists within 10 % of the best (0020).
+            finalists: 2,
+            finalist_duplicate_tol: 1e-3,
+            finalist_gap_tol: 0.1,
+            warm_mesh_changes: true, // 9-28 -> 3-11 iterations per mesh change (0006)
+            crossing_split: Some(0.3), // a crossing steps the exposure by ~1 (0029)
+        }
+    }
+}
+
+/// Planner settings that cannot be used.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlannerSettingsError {
+    #[error("swarm: {0}")]
+    Swarm(#[from] swarm::SwarmError),
+    #[error("`{stage}`: {source}")]
+    Nlp {
+        stage: &'static str,
+        source: crate::collocation::NlpSettingsError,
+    },
+    #[error("`{setting}`: {problem}")]
+    OutOfRange {
+        setting: &'static str,
+        problem: &'static str,
+    },
+}
+
+impl PlannerSettings {
+    /// Checks every stage's settings (the swarm's, the three NLP settings) and the
+    /// planner's own, so that a bad setting is refused before a plan starts.
+    pub fn validate(&self) -> Result<(), PlannerSettingsError> {
+        self.swarm.validate()?;
+        for (stage, nlp) in [
+            ("nlp", &self.nlp),
+            ("ranking_nlp", &self.ranking_nlp),
+            ("finalist_nlp", &self.finalist_nlp),
+        ] {
+            nlp.validate()
+                .map_err(|source| PlannerSettingsError::Nlp { stage, source })?;
+        }
+        let out = |setting: &'static str, problem: &'static str| {
+            Err(PlannerSettingsError::OutOfRange { setting, problem })
+        };
+        let fraction = |x: f64| x.is_finite() && x > 0.0 && x <= 1.0;
+        let non_negative = |x: f64| x.is_finite() && x >= 0.0;
+        if !fraction(self.swarm_share) {
+            return out("swarm_share", "must be in (0, 1]");
+        }
+        if self.starts == 0 {
+            return out("starts", "must be at least 1");
+        }
+        if !(1..=64).contains(&self.threads) {
+            return out("threads", "must be in 1..=64");
+        }
+        if self.finalists == 0 {
+            return out("finalists", "must be at least 1");
+        }
+        if self.refine_rounds > 16 {
+            return out("refine_rounds", "must be at most 16");
+        }
+        for (setting, value) in [
+            ("ranking_feasibility_tol", self.ranking_feasibility_tol),
+            ("finalist_duplicate_tol", self.finalist_duplicate_tol),
+            ("finalist_gap_tol", self.finalist_gap_tol),
+        ] {
+            if !non_negative(value) {
+                return out(setting, "must be finite and non-negative");
+            }
+        }
+        if self
+            .ranking_mu_init_3d
+            .is_some_and(|v| !(v.is_finite() && v > 0.0))
+        {
+            return out("ranking_mu_init_3d", "must be finite and positive when set");
+        }
+        if self
+            .crossing_split
+            .is_some_and(|v| !(v.is_finite() && v > 0.0))
+        {
+            return out("crossing_split", "must be finite and positive when set");
+        }
+        Ok(())
+    }
+}
