@@ -1,0 +1,219 @@
+//! The seed families as specs (bulge ratio per leg, altitude profile, family), in the order
+//! they are built: the bisector scan's combinations, the arcs, the fixed-time fits, the
+//! random curves (see the module documentation of [`crate::seeding`]).
+
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+use wingman_interfaces::{MAX_PHASES, Objective};
+
+use super::context::Context;
+use super::seed::{Altitude, SeedKind};
+use super::settings::SeedSettings;
+
+/// What to build one seed from.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Spec {
+    pub(super) bulges: [f64; MAX_PHASES],
+    pub(super) altitude: Altitude,
+    pub(super) kind: SeedKind,
+}
+
+/// The specs of every family, most promising first, at most `max_seeds` of them. The
+/// arcs (with too many legs for every combination) and the random curves draw from `rng`,
+/// in that order.
+pub(super) fn specs(ctx: &Context, settings: &SeedSettings, rng: &mut ChaCha8Rng) -> Vec<Spec> {
+    let legs = ctx.legs;
+    let altitudes: &[Altitude] = if ctx.spatial && settings.high_profile {
+        &[Altitude::Direct, Altitude::High]
+    } else {
+        &[Altitude::Direct]
+    };
+    let fit = settings.fit_fixed_time && ctx.problem.objective == Objective::FixedTime;
+    let n_signs = 3usize.saturating_pow(legs as u32) - 1;
+    let fit_budget = if fit {
+        n_signs.min(26) * altitudes.len()
+    } else {
+        0
+    };
+    let arc_budget = settings
+        .max_seeds
+        .saturating_sub(settings.random_seeds)
+        .saturating_sub(fit_budget)
+        .max(1);
+
+    let mut specs: Vec<Spec> = Vec::new();
+    scan_specs(ctx, settings, altitudes, &mut specs);
+    arc_specs(settings, legs, altitudes, arc_budget, rng, &mut specs);
+    if fit {
+        fit_specs(ctx, n_signs, altitudes, &mut specs);
+    }
+    random_specs(settings, legs, altitudes, rng, &mut specs);
+    specs.truncate(settings.max_seeds);
+    specs
+}
+
+/// Bisector scan: every combination of each leg's local minima (at most 27), cheapest
+/// first, the cheapest `scan_polish` polished in context.
+fn scan_specs(
+    ctx: &Context,
+    settings: &SeedSettings,
+    altitudes: &[Altitude],
+    specs: &mut Vec<Spec>,
+) {
+    let legs = ctx.legs;
+    if settings.scan_steps >= 2 && settings.scan_minima > 0 {
+        for &alt in altitudes {
+            if let (Some((mins, counts)), Some(end)) = (ctx.scan(settings, alt), ctx.scan_end()) {
+                let total: usize = counts[..legs].iter().product();
+                let mut combos: Vec<(f64, [f64; MAX_PHASES])> = (0..total.min(27))
+                    .map(|idx| {
+                        let mut bulges = [0.0; MAX_PHASES];
+                        let mut r = idx;
+                        for g in (0..legs).rev() {
+                            bulges[g] = mins[g][r % counts[g]];
+                            r /= counts[g];
+                        }
+                        (ctx.path_cost(&bulges, alt, &end), bulges)
+                    })
+                    .collect();
+                combos.sort_by(|a, b| a.0.total_cmp(&b.0));
+                let step = 2.0 * settings.scan_max / (settings.scan_steps - 1) as f64;
+                for (k, (_, mut bulges)) in combos.into_iter().enumerate() {
+                    if k < settings.scan_polish {
+                        ctx.polish(step, &mut bulges, alt, &end);
+                    }
+                    specs.push(Spec {
+                        bulges,
+                        altitude: alt,
+                        kind: SeedKind::Scan,
+                    });
+                }
+            }
+        }
+    }
+}
+
+/// Arcs: every combination of the options per leg `[0, +b1, -b1, +b2, -b2, ...]`, or
+/// with too many legs for every combination, the uniform patterns and distinct
+/// combinations drawn at random; the same patterns for each altitude profile.
+fn arc_specs(
+    settings: &SeedSettings,
+    legs: usize,
+    altitudes: &[Altitude],
+    arc_budget: usize,
+    rng: &mut ChaCha8Rng,
+    specs: &mut Vec<Spec>,
+) {
+    let mut options = vec![0.0];
+    for &b in &settings.bulge_ratios {
+        options.push(b);
+        options.push(-b);
+    }
+    let per_alt = (arc_budget / altitudes.len()).max(1);
+    let combos = options.len().checked_pow(legs as u32).unwrap_or(usize::MAX);
+    let mut patterns: Vec<[f64; MAX_PHASES]> = Vec::new();
+    if combos <= per_alt {
+        for idx in 0..combos {
+            patterns.push(decode(idx, &options, legs));
+        }
+    } else {
+        // Too many legs for every combination: the uniform patterns, then distinct
+        // combinations drawn at random.
+        for &o in &options {
+            let mut p = [0.0; MAX_PHASES];
+            p[..legs].fill(o);
+            patterns.push(p);
+        }
+        let mut tries = 0;
+        while patterns.len() < per_alt && tries < 100 * per_alt {
+            tries += 1;
+            let idx = rng.random_range(0..combos);
+            let p = decode(idx, &options, legs);
+            if !patterns.contains(&p) {
+                patterns.push(p);
+            }
+        }
+        patterns.truncate(per_alt);
+    }
+    for &alt in altitudes {
+        for p in &patterns {
+            specs.push(Spec {
+                bulges: *p,
+                altitude: alt,
+                kind: SeedKind::Arc,
+            });
+        }
+    }
+}
+
+/// Fixed-time fits: the sign patterns in {L, S, R}^legs except all straight (four
+/// alternating patterns when there are more than 26), each with its length-matching ratio.
+fn fit_specs(ctx: &Context, n_signs: usize, altitudes: &[Altitude], specs: &mut Vec<Spec>) {
+    let legs = ctx.legs;
+    let mut signs: Vec<[f64; MAX_PHASES]> = Vec::new();
+    if n_signs <= 26 {
+        for idx in 1..=n_signs {
+            signs.push(decode(idx, &[0.0, 1.0, -1.0], legs));
+        }
+    } else {
+        for (a, b) in [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)] {
+            let mut p = [0.0; MAX_PHASES];
+            for (g, v) in p[..legs].iter_mut().enumerate() {
+                *v = if g % 2 == 0 { a } else { b };
+            }
+            signs.push(p);
+        }
+    }
+    for &alt in altitudes {
+        for s in &signs {
+            if let Some(b) = ctx.fit_fixed_time(s, alt) {
+                let mut bulges = [0.0; MAX_PHASES];
+                for g in 0..legs {
+                    bulges[g] = s[g] * b;
+                }
+                specs.push(Spec {
+                    bulges,
+                    altitude: alt,
+                    kind: SeedKind::FixedTimeFit,
+                });
+            }
+        }
+    }
+}
+
+/// Random curves: a ratio per leg drawn uniformly from `[-random_bulge_max,
+/// random_bulge_max]`, then (with two profiles) a random profile.
+fn random_specs(
+    settings: &SeedSettings,
+    legs: usize,
+    altitudes: &[Altitude],
+    rng: &mut ChaCha8Rng,
+    specs: &mut Vec<Spec>,
+) {
+    for i in 0..settings.random_seeds {
+        let mut bulges = [0.0; MAX_PHASES];
+        for b in bulges[..legs].iter_mut() {
+            *b = settings.random_bulge_max * (2.0 * rng.random::<f64>() - 1.0);
+        }
+        let altitude = if altitudes.len() > 1 && rng.random::<f64>() < 0.5 {
+            Altitude::High
+        } else {
+            Altitude::Direct
+        };
+        specs.push(Spec {
+            bulges,
+            altitude,
+            kind: SeedKind::Random(i as u32),
+        });
+    }
+}
+
+/// Mixed-radix decoding of a combination index into a bulge per leg.
+pub(super) fn decode(mut idx: usize, options: &[f64], legs: usize) -> [f64; MAX_PHASES] {
+    let mut p = [0.0; MAX_PHASES];
+    for v in p[..legs].iter_mut().rev() {
+        *v = options[idx % options.len()];
+        idx /= options.len();
+    }
+    p
+}
