@@ -5,6 +5,7 @@ pub mod export;
 pub mod kkt;
 pub mod lgr;
 pub mod mesh;
+pub mod nlp_settings;
 pub mod refine;
 pub mod solve;
 pub mod transcription;
