@@ -1,5 +1,3 @@
-#[cfg(feature = "iceoryx2")]
-use crate::ZeroCopySend;
 use crate::validate::{self, Checked, ValidationError};
 use crate::wire_struct;
 

@@ -241,7 +241,6 @@ macro_rules! wire_struct {
     ) => {
         $(#[doc = $doc])*
         #[derive(Debug, Clone, Copy, PartialEq)]
-        #[cfg_attr(feature = "iceoryx2", derive($crate::ZeroCopySend), type_name($tn))]
         #[repr(C)]
         pub struct $name {
             $( $(#[doc = $fdoc])* pub $field: $ty, )*
@@ -251,6 +250,16 @@ macro_rules! wire_struct {
             ::core::mem::size_of::<$name>() == 0 $(+ ::core::mem::size_of::<$ty>())*,
             concat!("wire type ", stringify!($name), " has implicit padding"),
         );
+
+        // SAFETY: `#[repr(C)]`, every field is `Plain` (numbers, arrays of them, other wire
+        // structs) and there is no padding (both checked here), so the bytes mean the same
+        // in every process: what iceoryx2's derive would check, and more.
+        #[cfg(feature = "iceoryx2")]
+        unsafe impl $crate::ZeroCopySend for $name {
+            unsafe fn type_name() -> &'static str {
+                $tn
+            }
+        }
 
         // SAFETY: `#[repr(C)]`, every field is `Plain` (checked by the bounds below), and
         // the sizes add up, so there is no padding.

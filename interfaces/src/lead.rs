@@ -1,5 +1,3 @@
-#[cfg(feature = "iceoryx2")]
-use crate::ZeroCopySend;
 use crate::message::{Message, validate_common};
 use crate::validate::{self, Checked};
 use crate::{Header, MAX_ROUTE_POINTS, Service, wire_struct};

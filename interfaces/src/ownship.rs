@@ -1,5 +1,3 @@
-#[cfg(feature = "iceoryx2")]
-use crate::ZeroCopySend;
 use crate::message::{Message, validate_common};
 use crate::validate::{self, Checked};
 use crate::{CONTROL_DIM, Header, Model, STATE_DIM, Service, wire_struct};

@@ -1,5 +1,3 @@
-#[cfg(feature = "iceoryx2")]
-use crate::ZeroCopySend;
 use crate::message::{Message, validate_common};
 use crate::validate::{self, Checked, ValidationError};
 use crate::{Header, MAX_TARGETS, Model, Objective, STATE_DIM, Service, wire_struct};

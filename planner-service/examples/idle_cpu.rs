@@ -1,6 +1,6 @@
 //! Idle CPU of the planner service.
 //!
-//! Runs `service::run` in this process with the default configuration (heartbeat 1 s) on a
+//! Runs the service in this process (`ServiceThread`) with the default configuration (heartbeat 1 s) on a
 //! vehicle id of its own, gives it a world and a first plan (the tasking and threats of
 //! `2d-min-time-avoidable`), then reads this process's CPU time from the OS over idle
 //! seconds (10 by default): `/proc/self/stat` (utime + stime, in USER_HZ = 100 ticks) and
@@ -14,12 +14,10 @@
 
 use std::time::{Duration, Instant};
 
-use iceoryx2::port::update_connections::UpdateConnections;
-use wingman_interfaces::*;
-use wingman_ipc as ipc;
-use wingman_planner::service::{RunOptions, ServiceConfig, Shutdown};
-use wingman_planning::clock::MonotonicClock;
+use wingman_planner::service::{ServiceConfig, ServiceThread};
 use wingman_planning::scenario::bundled;
+use wingman_planning::scenario::messages::{take_off_tasking, take_off_threat_reports};
+use wingman_testkit::fake_harness::FakeHarness;
 
 /// CPU time of this process: (stat ticks in ns, schedstat ns over all threads).
 fn cpu_ns() -> (u64, u64) {
@@ -64,89 +62,17 @@ fn main() {
         vehicle_id: vehicle.clone(),
         ..ServiceConfig::default()
     };
-    let shutdown = Shutdown::new();
-    let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
-    let options = RunOptions {
-        config,
-        clock,
-        handle_signals: false,
-        shutdown: shutdown.clone(),
-    };
-    let service = std::thread::spawn(move || wingman_planner::service::run(options));
+    let service = ServiceThread::start(config).expect("start the service");
 
-    // A minimal harness: the world, a wake-up, then read the status.
-    let node = ipc::node(&format!("idle-harness-{vehicle}"), false).unwrap();
-    let threats =
-        ipc::publisher(&ipc::open_publish_subscribe::<ThreatReport>(&node, &vehicle).unwrap())
-            .unwrap();
-    let tasking =
-        ipc::publisher(&ipc::open_publish_subscribe::<Tasking>(&node, &vehicle).unwrap()).unwrap();
-    let status =
-        ipc::subscriber(&ipc::open_publish_subscribe::<PlannerStatus>(&node, &vehicle).unwrap())
-            .unwrap();
-    let wake = ipc::notifier(
-        &ipc::open_event(&node, &vehicle, Service::PlannerWake).unwrap(),
-        ipc::WAKE_INPUT,
-    )
-    .unwrap();
-    // Wait for the service's first heartbeat: its subscribers exist, so what is sent next
-    // reaches them (a publisher hands its history to late subscribers only when it sends
-    // again or updates its connections).
-    let started = Instant::now();
-    while status.receive().unwrap().is_none() {
-        let _ = status.update_connections();
-        assert!(started.elapsed() < Duration::from_secs(30), "no heartbeat");
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    // A minimal harness: the world and the tasking, a wake-up, then the first plan.
+    let mut h = FakeHarness::new(&vehicle);
     let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();
-    let mut seq = 0;
-    for (k, t) in sc.known_static_threats().enumerate() {
-        seq += 1;
-        let mut r = ThreatReport::zeroed();
-        r.header = Header::new(SENDER_HARNESS, seq, 0);
-        r.threat_id = k as u32 + 1;
-        r.kind = ThreatKind::Static.to_wire();
-        r.center_m = t.center_m;
-        r.axes_m = t.axes_m;
-        r.exponents = t.exponents;
-        r.yaw_rad = t.yaw_rad;
-        threats.send_copy(r).unwrap();
-    }
-    let mut t = Tasking::zeroed();
-    seq += 1;
-    t.header = Header::new(SENDER_HARNESS, seq, 0);
-    t.revision = 1;
-    t.model = sc.model.to_wire();
-    t.objective = sc.objective.to_wire();
-    t.limits = sc.vehicle;
-    t.weights = sc.weights;
-    let s = &sc.start;
-    t.start_state = s.state(sc.model);
-    let f = sc.final_point.as_ref().unwrap();
-    t.final_state = f.state(sc.model);
-    t.target_count = sc.targets.len() as u32;
-    for (k, p) in sc.targets.iter().enumerate() {
-        t.targets_m[k] = *p;
-    }
-    tasking.send_copy(t).unwrap();
-    wake.notify().unwrap();
-
-    let mut last = None;
-    while last.is_none_or(|s: PlannerStatus| {
-        s.plans_made == 0 || s.state == PlannerState::Planning.to_wire()
-    }) {
-        assert!(
-            started.elapsed() < Duration::from_secs(120),
-            "no first plan: {last:?}"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-        let _ = tasking.update_connections();
-        let _ = threats.update_connections();
-        while let Some(sample) = status.receive().unwrap() {
-            last = Some(*sample.payload());
-        }
-    }
-    let first = last.unwrap();
+    h.first_plan(
+        &take_off_threat_reports(&sc),
+        take_off_tasking(&sc, 1),
+        Duration::from_secs(120),
+    );
+    let first = h.last_status();
     println!(
         "first plan: id {} in {:.1} ms; now idle for {seconds} s (heartbeat {} ms)",
         first.current_plan_id,
@@ -155,19 +81,16 @@ fn main() {
     );
     // Let the plan's aftermath settle, then measure.
     std::thread::sleep(Duration::from_millis(500));
-    while let Some(sample) = status.receive().unwrap() {
-        last = Some(*sample.payload());
-    }
-    let seq0 = last.map_or(0, |s| s.header.sequence);
+    h.poll();
+    let seq0 = h.last_status().header.sequence;
     let (stat0, sched0) = cpu_ns();
     let t0 = Instant::now();
     std::thread::sleep(Duration::from_secs(seconds));
     let (stat1, sched1) = cpu_ns();
     let wall = t0.elapsed().as_secs_f64();
-    while let Some(sample) = status.receive().unwrap() {
-        last = Some(*sample.payload());
-    }
-    let heartbeats = last.map_or(0, |s| s.header.sequence) - seq0;
+    h.poll();
+    let last = h.last_status();
+    let heartbeats = last.header.sequence - seq0;
     let sched_ms = (sched1 - sched0) as f64 * 1e-6;
     let stat_ms = (stat1 - stat0) as f64 * 1e-6;
     let share = sched_ms / (wall * 1e3) * 100.0;
@@ -179,16 +102,11 @@ fn main() {
     );
     println!("statuses published       {heartbeats} (heartbeats)");
     println!("resident memory          {} KiB", rss_kib());
-    println!(
-        "plans made               {}",
-        last.map(|s| s.plans_made).unwrap_or(0)
-    );
+    println!("plans made               {}", last.plans_made);
     let verdict = if share < 1.0 { "below" } else { "ABOVE" };
     println!("idle CPU is {verdict} 1 % of one core");
 
-    shutdown.request();
-    wake.notify().unwrap();
-    let summary = service.join().unwrap().unwrap();
+    let summary = service.stop(|| h.wake()).expect("the service stops");
     println!("service stopped: {:?}", summary.exit);
     if share >= 1.0 {
         std::process::exit(1);

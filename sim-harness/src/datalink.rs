@@ -4,7 +4,7 @@
 
 use wingman_interfaces::{LeadRoute, LeadState, MAX_ROUTE_POINTS, MAX_TARGETS, Tasking, Wire};
 use wingman_planning::lead::{LeadError, LeadPath, LeadPoint};
-use wingman_planning::scenario::{EventKind, FinalPoint, Scenario, messages};
+use wingman_planning::scenario::{EventKind, Scenario, messages};
 
 /// A scenario whose tasking or route does not fit the messages.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -15,6 +15,12 @@ pub enum DatalinkError {
     RoutePoints(usize),
     #[error("lead route: {0}")]
     Lead(#[from] LeadError),
+}
+
+impl From<messages::TooManyTargets> for DatalinkError {
+    fn from(e: messages::TooManyTargets) -> Self {
+        DatalinkError::TooManyTargets(e.0)
+    }
 }
 
 /// One tasking revision and the mission time it is sent at.
@@ -44,7 +50,7 @@ pub struct Datalink {
 impl Datalink {
     /// Every tasking and route revision of `sc`, in time order.
     pub fn new(sc: &Scenario) -> Result<Datalink, DatalinkError> {
-        let first = tasking(sc, 1, &sc.targets, sc.final_point.as_ref())?;
+        let first = messages::tasking(sc, 1, &sc.targets, sc.final_point.as_ref())?;
         let mut taskings = vec![TaskingRevision {
             at_s: sc.start.time_s,
             tasking: first,
@@ -63,7 +69,7 @@ impl Datalink {
                 }
                 EventKind::Targets { targets_m } => {
                     let prev = taskings.last().map(|r| r.tasking).unwrap_or(first);
-                    let mut t = tasking(sc, prev.revision + 1, targets_m, None)?;
+                    let mut t = messages::tasking(sc, prev.revision + 1, targets_m, None)?;
                     t.final_state = prev.final_state;
                     t.final_time_s = prev.final_time_s;
                     taskings.push(TaskingRevision {
@@ -155,17 +161,6 @@ impl Datalink {
         m.route_revision = r.message.revision;
         Some(m)
     }
-}
-
-/// The tasking of `sc` with `targets` (header left for the sender).
-pub fn tasking(
-    sc: &Scenario,
-    revision: u32,
-    targets: &[[f64; 3]],
-    final_point: Option<&FinalPoint>,
-) -> Result<Tasking, DatalinkError> {
-    messages::tasking(sc, revision, targets, final_point)
-        .map_err(|e| DatalinkError::TooManyTargets(e.0))
 }
 
 fn route(

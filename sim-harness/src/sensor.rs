@@ -8,9 +8,9 @@
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use wingman_interfaces::{MAX_ROAD_POINTS, ThreatKind, ThreatReport, TrackFix, Wire, threat_name};
+use wingman_interfaces::{MAX_ROAD_POINTS, ThreatKind, ThreatReport, TrackFix, Wire};
 use wingman_planning::estimation::{Estimate, EstimationError, GaussMarkov, Road};
-use wingman_planning::scenario::{MovingThreatSpec, Scenario, StaticThreatSpec};
+use wingman_planning::scenario::{MovingThreatSpec, Scenario, StaticThreatSpec, messages};
 
 /// A scenario's threat that the sensor cannot emulate.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -249,14 +249,11 @@ impl ThreatSensor {
 }
 
 fn static_report(id: u32, s: &StaticThreatSpec) -> ThreatReport {
-    wingman_planning::scenario::messages::static_threat_report(id, s)
+    messages::static_threat_report(id, s)
 }
 
 fn moving_report(id: u32, m: &MovingThreatSpec, est: &Estimate) -> ThreatReport {
-    let mut r = ThreatReport::zeroed();
-    r.threat_id = id;
-    r.kind = ThreatKind::Moving.to_wire();
-    r.name = threat_name(&m.name);
+    let mut r = messages::threat_report(id, ThreatKind::Moving, &m.name);
     r.appeared_at_s = m.appears_at_s;
     r.axes_m = m.axes_m;
     r.road_point_count = m.road_m.len() as u32;

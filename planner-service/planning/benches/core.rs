@@ -5,54 +5,28 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use wingman_planning::estimation::{Estimate, GaussMarkov, KalmanFilter, MovingThreat, Road};
+use wingman_planning::estimation::{Estimate, GaussMarkov, KalmanFilter, MovingThreat};
+use wingman_planning::problem::{Problem, Threats};
 use wingman_planning::replan::{PlanPoint, moving_popup_hit, replan_time};
-use wingman_planning::threat::{Superquadric, ThreatLayout};
+use wingman_planning::scenario::bundled;
+use wingman_planning::threat::ThreatLayout;
 
-/// The five static threats of `scenarios/3d-replan-popups.toml` known at take-off
-/// ("popup-far" appears at 300 s and is left out), stiffness 30.
-fn popups_layout() -> ThreatLayout<3> {
-    let t = |c: [f64; 3], a: [f64; 3], p: [f64; 3]| Superquadric::new(c, a, p, 0.0).unwrap();
-    ThreatLayout::with_threats(
-        30.0,
-        &[
-            t(
-                [30000.0, 40000.0, 0.0],
-                [25000.0, 25000.0, 25000.0],
-                [2.0; 3],
-            ),
-            t(
-                [95000.0, 95000.0, 0.0],
-                [18000.0, 18000.0, 15000.0],
-                [2.0; 3],
-            ),
-            t([125000.0, 45000.0, 0.0], [6000.0, 6000.0, 3000.0], [2.0; 3]),
-            t(
-                [60000.0, 125000.0, 0.0],
-                [25000.0, 25000.0, 15000.0],
-                [2.0; 3],
-            ),
-            t(
-                [140000.0, 75000.0, 0.0],
-                [20000.0, 20000.0, 15000.0],
-                [2.0, 2.0, 8.0],
-            ),
-        ],
-    )
-    .unwrap()
+/// The static threats of `scenarios/3d-replan-popups.toml` known at take-off and its
+/// moving threat "mobile-sam" (estimate at t = 0), as the planner's problem holds them.
+fn popups() -> (ThreatLayout<3>, MovingThreat<3>) {
+    let sc = bundled("3d-replan-popups").unwrap().unwrap();
+    match Problem::from_scenario(&sc).unwrap().threats {
+        Threats::Spatial { layout, moving } => (layout, moving.into_iter().next().unwrap()),
+        Threats::Planar { .. } => unreachable!("a 3-D scenario"),
+    }
 }
 
-/// Its moving threat "mobile-sam", estimate at t = 0.
+fn popups_layout() -> ThreatLayout<3> {
+    popups().0
+}
+
 fn mobile_sam() -> MovingThreat<3> {
-    let road = Road::new(&[[70000.0, 0.0, 0.0], [100000.0, 150000.0, 0.0]]).unwrap();
-    let est = Estimate::with_sigmas(0.0, [58000.0, 15.0, 0.0], [500.0, 3.0, 0.3]).unwrap();
-    MovingThreat::new(
-        road,
-        [10000.0, 10000.0, 12000.0],
-        GaussMarkov::new(60.0, 0.3).unwrap(),
-        est,
-    )
-    .unwrap()
+    popups().1
 }
 
 /// 32 x 32 points over the scenario's area (x 0..160 km, y 0..140 km) at 3000 m.

@@ -24,6 +24,9 @@ use wingman_planning::estimation::{
 // -------------------------------------------------------------------------------------------
 
 /// `(t, var_d(t))`.
+mod common;
+use common::{mobile_sam, popups_layout};
+
 const PY_VAR_D: [(f64, f64); 8] = [
     (0.0, 250000.0),
     (0.5, 250002.25140313033),
@@ -175,18 +178,6 @@ const PY_POLY_F: [(f64, [f64; 3], f64); 8] = [
     (500.0, [3500.0, 8000.0, 0.0], 1.0892984229335456),
     (500.0, [-2000.0, 12500.0, 400.0], 0.29530502587600327),
 ];
-
-fn mobile_sam() -> MovingThreat<3> {
-    let road = Road::new(&[[70000.0, 0.0, 0.0], [100000.0, 150000.0, 0.0]]).unwrap();
-    let est = Estimate::with_sigmas(0.0, [58000.0, 15.0, 0.0], [500.0, 3.0, 0.3]).unwrap();
-    MovingThreat::new(
-        road,
-        [10000.0, 10000.0, 12000.0],
-        GaussMarkov::new(60.0, 0.3).unwrap(),
-        est,
-    )
-    .unwrap()
-}
 
 fn poly_threat() -> MovingThreat<3> {
     let road = Road::new(&POLY_ROAD).unwrap();
@@ -725,25 +716,7 @@ fn moving_threat_is_finite_at_extreme_inputs() {
 #[test]
 fn exposure_with_a_moving_threat_matches_finite_differences() {
     use wingman_planning::estimation::{exposure_at, exposure_eval_at};
-    use wingman_planning::threat::{Superquadric, ThreatLayout};
-    let t = |c: [f64; 3], a: [f64; 3], p: [f64; 3]| Superquadric::new(c, a, p, 0.0).unwrap();
-    let layout = ThreatLayout::with_threats(
-        30.0,
-        &[
-            t(
-                [30000.0, 40000.0, 0.0],
-                [25000.0, 25000.0, 25000.0],
-                [2.0; 3],
-            ),
-            t(
-                [95000.0, 95000.0, 0.0],
-                [18000.0, 18000.0, 15000.0],
-                [2.0; 3],
-            ),
-            t([125000.0, 45000.0, 0.0], [6000.0, 6000.0, 3000.0], [2.0; 3]),
-        ],
-    )
-    .unwrap();
+    let layout = popups_layout();
     let mv = [mobile_sam()];
     let mut rng = ChaCha8Rng::seed_from_u64(0x0e00_0123);
     let mut checked = 0;

@@ -9,52 +9,17 @@ use std::hint::black_box;
 
 use wingman_planning::dynamics::{OdeModel, Spatial, rk4_step};
 use wingman_planning::estimation::{
-    Estimate, GaussMarkov, KalmanFilter, MovingThreat, Road, exposure_at, exposure_eval_at,
+    Estimate, GaussMarkov, KalmanFilter, Road, exposure_at, exposure_eval_at,
 };
 use wingman_planning::metrics::exposure_integral;
 use wingman_planning::replan::{PlanPoint, moving_popup_hit, replan_time};
-use wingman_planning::threat::{Superquadric, ThreatLayout};
+
+mod common;
+use common::{mobile_sam, popups_layout};
 
 wingman_testkit::counting_allocator!();
 use counting_alloc::allocations_in;
 use wingman_testkit::counting_alloc;
-
-fn layout() -> ThreatLayout<3> {
-    let t = |c: [f64; 3], a: [f64; 3], p: [f64; 3]| Superquadric::new(c, a, p, 0.3).unwrap();
-    ThreatLayout::with_threats(
-        30.0,
-        &[
-            t(
-                [30000.0, 40000.0, 0.0],
-                [25000.0, 25000.0, 25000.0],
-                [2.0; 3],
-            ),
-            t(
-                [95000.0, 95000.0, 0.0],
-                [18000.0, 18000.0, 15000.0],
-                [2.5, 2.0, 1.5],
-            ),
-            t(
-                [140000.0, 75000.0, 0.0],
-                [20000.0, 20000.0, 15000.0],
-                [2.0, 2.0, 8.0],
-            ),
-        ],
-    )
-    .unwrap()
-}
-
-fn moving() -> MovingThreat<3> {
-    let road = Road::new(&[[70000.0, 0.0, 0.0], [100000.0, 150000.0, 0.0]]).unwrap();
-    let est = Estimate::with_sigmas(0.0, [58000.0, 15.0, 0.0], [500.0, 3.0, 0.3]).unwrap();
-    MovingThreat::new(
-        road,
-        [10000.0, 10000.0, 12000.0],
-        GaussMarkov::new(60.0, 0.3).unwrap(),
-        est,
-    )
-    .unwrap()
-}
 
 #[test]
 fn the_counter_sees_allocations() {
@@ -96,8 +61,8 @@ fn kalman_predict_and_update_do_not_allocate() {
 
 #[test]
 fn exposure_and_derivatives_do_not_allocate() {
-    let layout = layout();
-    let mv = [moving()];
+    let layout = popups_layout();
+    let mv = [mobile_sam()];
     let n = allocations_in(|| {
         for i in 0..500 {
             let w = [300.0 * i as f64, 200.0 * i as f64, 5000.0];
@@ -115,8 +80,8 @@ fn exposure_and_derivatives_do_not_allocate() {
 #[test]
 fn dynamics_replan_and_metrics_do_not_allocate() {
     let model = Spatial::new(250.0).unwrap();
-    let threat = moving();
-    let layout = layout();
+    let threat = mobile_sam();
+    let layout = popups_layout();
     let plan: Vec<PlanPoint<3>> = (0..512)
         .map(|i| {
             let t = i as f64;

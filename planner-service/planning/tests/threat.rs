@@ -9,43 +9,14 @@ use nalgebra::SMatrix;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use wingman_planning::threat::{
-    CUTOFF_DELTA, MAX_THREATS, Superquadric, Threat2, Threat3, ThreatError, ThreatLayout, cutoff_f,
-    eps, eps_derivs,
+    CUTOFF_DELTA, MAX_THREATS, Threat2, Threat3, ThreatError, ThreatLayout, cutoff_f, eps,
+    eps_derivs,
 };
 
-const DEG: f64 = std::f64::consts::PI / 180.0;
+mod common;
+use common::popups_layout;
 
-/// The five static threats of `scenarios/3d-replan-popups.toml`, known at take-off.
-fn popups_layout() -> ThreatLayout<3> {
-    let t = |c: [f64; 3], a: [f64; 3], p: [f64; 3]| Superquadric::new(c, a, p, 0.0).unwrap();
-    ThreatLayout::with_threats(
-        30.0,
-        &[
-            t(
-                [30000.0, 40000.0, 0.0],
-                [25000.0, 25000.0, 25000.0],
-                [2.0; 3],
-            ),
-            t(
-                [95000.0, 95000.0, 0.0],
-                [18000.0, 18000.0, 15000.0],
-                [2.0; 3],
-            ),
-            t([125000.0, 45000.0, 0.0], [6000.0, 6000.0, 3000.0], [2.0; 3]),
-            t(
-                [60000.0, 125000.0, 0.0],
-                [25000.0, 25000.0, 15000.0],
-                [2.0; 3],
-            ),
-            t(
-                [140000.0, 75000.0, 0.0],
-                [20000.0, 20000.0, 15000.0],
-                [2.0, 2.0, 8.0],
-            ),
-        ],
-    )
-    .unwrap()
-}
+const DEG: f64 = std::f64::consts::PI / 180.0;
 
 /// The judge's own exposure, `0.5 (1 + tanh(s (F - 1) / 2))` (scenario.py `exposure_eps`).
 fn eps_tanh(f: f64, s: f64) -> f64 {

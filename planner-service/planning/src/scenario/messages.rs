@@ -53,12 +53,18 @@ pub fn take_off_tasking(sc: &Scenario, revision: u32) -> Tasking {
         .unwrap_or_else(|e| unreachable!("the scenario loader refuses {e}"))
 }
 
-/// The report of static threat `s` under id `id`.
-pub fn static_threat_report(id: u32, s: &StaticThreatSpec) -> ThreatReport {
+/// A report of threat `id`, of `kind`, named `name`, its other fields zero.
+pub fn threat_report(id: u32, kind: ThreatKind, name: &str) -> ThreatReport {
     let mut r = ThreatReport::zeroed();
     r.threat_id = id;
-    r.kind = ThreatKind::Static.to_wire();
-    r.name = threat_name(&s.name);
+    r.kind = kind.to_wire();
+    r.name = threat_name(name);
+    r
+}
+
+/// The report of static threat `s` under id `id`.
+pub fn static_threat_report(id: u32, s: &StaticThreatSpec) -> ThreatReport {
+    let mut r = threat_report(id, ThreatKind::Static, &s.name);
     r.center_m = s.center_m;
     r.axes_m = s.axes_m;
     r.exponents = s.exponents;
