@@ -1,5 +1,5 @@
-//! The service's decisions as pure functions (`service::triggers`, `service::export`,
-//! `service::config`): each trigger fires on the case that should fire it and not on the
+//! The service's decisions as pure functions (`service::triggers`,
+//! `wingman_planning::plan_message`, `wingman_ipc::config`): each trigger fires on the case that should fire it and not on the
 //! near miss beside it.
 //!
 //! Geometry of the pop-up and `t_r` cases: the plan flies east along `y = 0` at 200 m/s,

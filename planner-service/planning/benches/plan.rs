@@ -70,7 +70,7 @@ static GLOBAL: Peak = Peak;
 /// the planner runs; the slower thread's median of three timings, in ms. Timed before
 /// every round of plans, so that their times can be read against the speed the host had
 /// while they ran (a shared VM's speed swings by up to 1.8× within minutes;
-/// docs/BENCHMARKS.md).
+/// docs/decisions/0024-measuring-on-a-noisy-host.md).
 fn host_reference_ms() -> f64 {
     std::thread::scope(|s| {
         let other = s.spawn(reference_workload_ms);

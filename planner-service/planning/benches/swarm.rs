@@ -3,7 +3,7 @@
 //! the swarm's best cost and objective against the reference optimum
 //! (`../shared/reference/costs.toml`, when present), the spread of the objective across
 //! seeds, and the best path's target and end pass distances. Numbers and the command are
-//! in `docs/BENCHMARKS.md` ("Swarm (issue 5)").
+//! in `docs/BENCHMARKS.md` (its swarm section).
 //!
 //! Environment: `SWARM_RUNS` (runs per scenario), `SWARM_ONLY` (substring filter on the
 //! scenario name), `SWARM_THREADS`, `SWARM_PARTICLES`, `SWARM_ITERATIONS`, `SWARM_DT`,

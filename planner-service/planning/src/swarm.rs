@@ -115,7 +115,7 @@
 //!
 //! # Defaults
 //!
-//! Measured on the canonical scenarios (`docs/BENCHMARKS.md`, "Swarm (issue 5)"):
+//! Measured on the canonical scenarios (`docs/decisions/0004-swarm-size-and-iterations.md`):
 //! `dt = 20 s` with 3 samples of 6.7 s (1.3–1.7 km: fine against threats of 6–25 km
 //! semi-axes; the guidance acts at every sample, so a coarser `dt` only lowers the
 //! dimension: 20 s halves it against 10 s at the same basin rate), 24 particles in 4

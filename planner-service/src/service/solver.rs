@@ -329,7 +329,7 @@ fn parse_cpu_ticks(stat: &[u8]) -> Option<u64> {
 /// published; the margin covers the hand-over to the message thread and on to the tracker
 /// (measured up to 9 ms under a CPU hog on both cores) and an NLP iteration that runs
 /// longer than the ones before it on a loaded core (up to 7 ms past the planner's own
-/// deadline in 2-D, 35 ms in 3-D without a margin; `docs/BENCHMARKS.md`).
+/// deadline in 2-D, 35 ms in 3-D without a margin; `docs/decisions/0010-handover-margin.md`).
 pub fn handover_margin(budget: std::time::Duration) -> std::time::Duration {
     budget
         .mul_f64(0.02)

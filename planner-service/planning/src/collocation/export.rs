@@ -30,7 +30,7 @@ pub struct ExportSettings {
     /// spacing, whatever this is). 0.25 s (two RK4 steps per
     /// 0.5 s sample): the exported states stay within 7 cm of the judge's open-loop replay
     /// (DOP853, rtol 1e-11) on the 3-D canonical plans, against 0.3 mm at 0.1 s, for half
-    /// the replay's cost (docs/BENCHMARKS.md).
+    /// the replay's cost (docs/decisions/0031-closed-loop-replay-step.md).
     pub integration_step_s: f64,
     /// Gains of the tracking law that flies the plan.
     pub gains: TrackingGains,

@@ -58,7 +58,7 @@ pub struct NlpSettings {
     /// of mesh intervals ([`super::kkt`]; FERAL where the structure does not hold). The
     /// restoration phase keeps FERAL either way. Structured by default: on the canonical
     /// scenarios (probe, 3 seeds, same window) 38-62 % less plan time, the same costs
-    /// (docs/BENCHMARKS.md).
+    /// (docs/decisions/0015-structured-kkt-backend.md).
     pub kkt: KktSolver,
     /// Initial barrier parameter of a cold start (`None`: the solver's default, 0.1).
     pub mu_init: Option<f64>,

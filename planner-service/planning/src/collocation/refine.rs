@@ -38,7 +38,7 @@ impl Default for RefineSettings {
         RefineSettings {
             // 6 m: on the 15 canonical scenarios (seeds 1-5) the refined meshes are
             // smaller than at 3 m and the plans 1-5 % faster; judged, the costs and the
-            // final misses stay within their limits (docs/BENCHMARKS.md).
+            // final misses stay within their limits (docs/decisions/0011-refinement-rounds-and-tolerance.md).
             defect_tol_m: 6.0,
             max_split: 4,
             max_intervals_per_phase: 64,
@@ -164,7 +164,7 @@ pub fn refine(mesh: &Mesh, errors: &[f64], settings: &RefineSettings) -> Option<
 /// that the refinement round would split after it costs the final little, while the round
 /// no longer has to re-converge across the threat's edge: on the canonical scenarios the
 /// rounds of 2d-min-time-unavoidable fell from 16–22 iterations to 4–5
-/// (docs/BENCHMARKS.md). The last phase is left alone: split there too, the finals of
+/// (docs/decisions/0029-finals-mesh-crossing-split.md). The last phase is left alone: split there too, the finals of
 /// 2d-min-time-rendezvous-unavoidable took up to twice the iterations.
 pub fn split_crossings(
     mesh: &Mesh,
