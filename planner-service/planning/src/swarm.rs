@@ -115,15 +115,9 @@
 //!
 //! # Defaults
 //!
-//! Measured on the canonical scenarios (`docs/decisions/0004-swarm-size-and-iterations.md`):
-//! `dt = 20 s` with 3 samples of 6.7 s (1.3–1.7 km: fine against threats of 6–25 km
-//! semi-axes; the guidance acts at every sample, so a coarser `dt` only lowers the
-//! dimension: 20 s halves it against 10 s at the same basin rate), 24 particles in 4
-//! groups, at most 100 iterations and a stall stop after 30 iterations without a 1e-4
-//! relative gain of any group; `D* = 5 km` (dissertation); two threads (see
-//! [`SwarmSettings::threads`]). That is a median of 12–19 ms on the 2-D scenarios and
-//! 27–47 ms on the 3-D ones (one thread: 17–26 ms and 39–62 ms); 32 particles, 150
-//! iterations and 5 s samples cost 2.3 times as much for a basin rate no better.
+//! `dt = 20 s` with 3 samples, 24 particles in 4 groups, at most 100 iterations, a stall
+//! stop after 30 without a 1e-4 gain, `D* = 5 km` (dissertation), two threads: why, with
+//! the measurements, in `docs/decisions/0004-swarm-size-and-iterations.md`.
 
 #[cfg(doc)]
 use crate::problem::Problem;
