@@ -10,10 +10,12 @@
 use std::error::Error;
 use std::path::Path;
 
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use wingman_interfaces::{Model, Objective, Trigger};
 use wingman_planning::estimation::{GaussMarkov, MovingThreat, Road};
 use wingman_planning::problem::Problem;
+use wingman_planning::scenario::Scenario;
 use wingman_plot::{self as plot, MapMarker, MapPath, MapPlot, Stroke};
 
 use crate::mission::Flight;
@@ -63,7 +65,41 @@ pub fn draw_all(flight: &Flight, report: &Report, out: &Path) -> PlotResult<Vec<
 /// The map.
 pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
     let sc = &flight.scenario;
-    // Every threat of the truth on the map: pop-ups and moving threats as if known.
+    let problem = truth_problem(sc)?;
+    let mut paths = lead_paths(flight);
+    paths.extend(moving_threat_paths(flight));
+    paths.extend(plan_paths(flight));
+    paths.push(MapPath {
+        label: Some("flown path".into()),
+        color: BLACK,
+        stroke: Stroke::Bold,
+        // One point a second: a thick line through every 0.1 s step renders jagged.
+        points: decimated(flight)
+            .map(|s| [s.state[0], s.state[1]])
+            .collect(),
+    });
+    let outlines = keep_out_outlines(flight);
+    let mut markers = map_markers(flight);
+    markers.extend(legend_room(sc, &paths, &markers));
+    let title = format!(
+        "{} — {} plan(s), flown with the {} clock{}",
+        sc.name,
+        flight.plans.len(),
+        flight.clock,
+        resumed_note(flight)
+    );
+    let plot = MapPlot {
+        title,
+        problem: &problem,
+        outlines,
+        paths,
+        markers,
+    };
+    plot::draw_map(path, &plot, (1400, 1200)).map_err(boxed)
+}
+
+/// The problem of every threat of the truth: pop-ups and moving threats as if known.
+fn truth_problem(sc: &Scenario) -> PlotResult<Problem> {
     let mut all = sc.clone();
     for t in &mut all.threats {
         t.appears_at_s = None;
@@ -72,11 +108,15 @@ pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
         m.appears_at_s = sc.start.time_s;
     }
     all.events.clear();
-    let problem = Problem::from_scenario(&all).map_err(boxed)?;
-    let mut paths = Vec::new();
+    Problem::from_scenario(&all).map_err(boxed)
+}
+
+/// The lead's routes, each where the lead flew it: from its time to the next route's or
+/// the end.
+fn lead_paths(flight: &Flight) -> Vec<MapPath> {
     let routes = flight.datalink.routes();
+    let mut paths = Vec::new();
     for (k, r) in routes.iter().enumerate() {
-        // Where the lead flew this route: from its time to the next route's or the end.
         let until = routes
             .get(k + 1)
             .map_or(flight.end_s, |next| next.at_s)
@@ -102,6 +142,13 @@ pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
             points: pts,
         });
     }
+    paths
+}
+
+/// Each moving threat's true path from its appearance.
+fn moving_threat_paths(flight: &Flight) -> Vec<MapPath> {
+    let sc = &flight.scenario;
+    let mut paths = Vec::new();
     for (i, truth) in flight.truth.iter().enumerate() {
         let appears = sc.moving_threats[i].appears_at_s;
         let pts: Vec<[f64; 2]> = truth
@@ -118,6 +165,12 @@ pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
             });
         }
     }
+    paths
+}
+
+/// Every plan, in its colour.
+fn plan_paths(flight: &Flight) -> Vec<MapPath> {
+    let mut paths = Vec::new();
     for (k, p) in flight.plans.iter().enumerate() {
         let plan = &p.plan;
         let pts = plan
@@ -137,15 +190,12 @@ pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
             points: pts,
         });
     }
-    paths.push(MapPath {
-        label: Some("flown path".into()),
-        color: BLACK,
-        stroke: Stroke::Bold,
-        // One point a second: a thick line through every 0.1 s step renders jagged.
-        points: decimated(flight)
-            .map(|s| [s.state[0], s.state[1]])
-            .collect(),
-    });
+    paths
+}
+
+/// A moving threat's keep-out region as estimated at each plan, in the plan's colour.
+fn keep_out_outlines(flight: &Flight) -> Vec<(String, RGBColor, Vec<[f64; 2]>)> {
+    let sc = &flight.scenario;
     let mut outlines = Vec::new();
     for (n, e) in flight.estimates.iter().enumerate() {
         let Some(m) = sc.moving_threats.get(e.threat) else {
@@ -169,6 +219,12 @@ pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
         };
         outlines.push((label, plan_color(k), region));
     }
+    outlines
+}
+
+/// The start, the targets, the end, the final point and the static threats' names.
+fn map_markers(flight: &Flight) -> Vec<MapMarker> {
+    let sc = &flight.scenario;
     let mut markers = vec![MapMarker {
         label: " start".into(),
         color: BLACK,
@@ -210,7 +266,13 @@ pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
             at: [t.center_m[0], t.center_m[1]],
         });
     }
-    // Room for the legend in the upper left corner: an invisible point beyond the drawing.
+    markers
+}
+
+/// Invisible markers that make room for the legend in the upper left corner (a point
+/// beyond the drawing) and for the labels of points on the right edge; none for an empty
+/// map.
+fn legend_room(sc: &Scenario, paths: &[MapPath], markers: &[MapMarker]) -> Vec<MapMarker> {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for p in paths
         .iter()
@@ -226,35 +288,22 @@ pub fn map(flight: &Flight, path: &Path) -> PlotResult<()> {
         lo[0] = lo[0].min(t.center_m[0] - t.axes_m[0].max(t.axes_m[1]));
         hi[1] = hi[1].max(t.center_m[1] + t.axes_m[0].max(t.axes_m[1]));
     }
-    if lo[0].is_finite() {
-        let span = (hi[0] - lo[0]).max(hi[1] - lo[1]);
-        markers.push(MapMarker {
+    if !lo[0].is_finite() {
+        return Vec::new();
+    }
+    let span = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    vec![
+        MapMarker {
             label: String::new(),
             color: WHITE,
             at: [lo[0] - 0.32 * span, hi[1] + 0.05 * span],
-        });
-        // … and for the labels of points on the right edge.
-        markers.push(MapMarker {
+        },
+        MapMarker {
             label: String::new(),
             color: WHITE,
             at: [hi[0] + 0.1 * span, lo[1]],
-        });
-    }
-    let title = format!(
-        "{} — {} plan(s), flown with the {} clock{}",
-        sc.name,
-        flight.plans.len(),
-        flight.clock,
-        resumed_note(flight)
-    );
-    let plot = MapPlot {
-        title,
-        problem: &problem,
-        outlines,
-        paths,
-        markers,
-    };
-    plot::draw_map(path, &plot, (1400, 1200)).map_err(boxed)
+        },
+    ]
 }
 
 /// Footprint of the keep-out region a snapshot's estimate gives at its time.
@@ -288,7 +337,7 @@ fn resumed_note(flight: &Flight) -> String {
 pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()> {
     let times: Vec<f64> = flight.samples.iter().map(|s| s.t).collect();
     let exposure = exposure_series(flight).map_err(boxed)?;
-    let (t0, t1) = (
+    let span = (
         times.first().copied().unwrap_or(0.0),
         times.last().copied().unwrap_or(1.0).max(1.0),
     );
@@ -305,28 +354,58 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
         )
         .map_err(boxed)?;
     let panels = root.split_evenly((3, 1));
+    exposure_panel(&panels[0], flight, report, (&times, &exposure), span)?;
+    deviation_panel(&panels[1], flight, span)?;
+    plans_panel(&panels[2], flight, span)?;
+    root.present().map_err(boxed)?;
+    Ok(())
+}
 
-    // 1. Exposure.
-    let e_max = exposure.iter().copied().fold(0.0, f64::max).max(1e-3) * 1.15;
-    let mut c = ChartBuilder::on(&panels[0])
+/// One panel of the timeline over mission time `t0..t1`: its chart with the caption and
+/// the axes drawn.
+fn timeline_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: impl AsRef<str>,
+    (t0, t1): (f64, f64),
+    y: std::ops::Range<f64>,
+    y_desc: &str,
+) -> PlotResult<Chart<'a, DB>>
+where
+    DB::ErrorType: 'static,
+{
+    let mut c = ChartBuilder::on(area)
         .margin(12)
         .x_label_area_size(36)
         .y_label_area_size(70)
-        .caption(
-            format!(
-                "exposure E along the flown path (integral {:.3} s)",
-                report.exposure_integral
-            ),
-            ("sans-serif", 18),
-        )
-        .build_cartesian_2d(t0..t1, 0.0..e_max)
+        .caption(caption, ("sans-serif", 18))
+        .build_cartesian_2d(t0..t1, y)
         .map_err(boxed)?;
     c.configure_mesh()
         .x_desc("mission time [s]")
-        .y_desc("E [-]")
+        .y_desc(y_desc)
         .label_style(("sans-serif", 14))
         .draw()
         .map_err(boxed)?;
+    Ok(c)
+}
+
+/// Panel 1: exposure `E` along the flown path (`times`, `exposure`).
+fn exposure_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    flight: &Flight,
+    report: &Report,
+    (times, exposure): (&[f64], &[f64]),
+    span: (f64, f64),
+) -> PlotResult<()>
+where
+    DB::ErrorType: 'static,
+{
+    let e_max = exposure.iter().copied().fold(0.0, f64::max).max(1e-3) * 1.15;
+    let caption = format!(
+        "exposure E along the flown path (integral {:.3} s)",
+        report.exposure_integral
+    );
+    let mut c = timeline_chart(area, caption, span, 0.0..e_max, "E [-]")?;
     c.draw_series(LineSeries::new(
         times.iter().copied().zip(exposure.iter().copied()),
         RGBColor(200, 40, 30).stroke_width(2),
@@ -335,9 +414,19 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
     .label("E (truth: every static threat, moving threats at their true position)")
     .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RGBColor(200, 40, 30)));
     replan_lines(&mut c, flight, (0.0, e_max))?;
-    legend(&mut c)?;
+    legend(&mut c)
+}
 
-    // 2. Deviation.
+/// Panel 2: the tracker's deviation from the plan it flies (cross-track, and vertical in
+/// 3-D), with the holds shaded.
+fn deviation_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    flight: &Flight,
+    (t0, t1): (f64, f64),
+) -> PlotResult<()>
+where
+    DB::ErrorType: 'static,
+{
     let three_d = flight.scenario.model == Model::ThreeD;
     let d_max = flight
         .samples
@@ -345,22 +434,13 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
         .flat_map(|s| [s.deviation.cross_m.abs(), s.deviation.vertical_m.abs()])
         .fold(1.0, f64::max)
         * 1.15;
-    let mut c = ChartBuilder::on(&panels[1])
-        .margin(12)
-        .x_label_area_size(36)
-        .y_label_area_size(70)
-        .caption(
-            "tracker's deviation from the plan it flies",
-            ("sans-serif", 18),
-        )
-        .build_cartesian_2d(t0..t1, -d_max..d_max)
-        .map_err(boxed)?;
-    c.configure_mesh()
-        .x_desc("mission time [s]")
-        .y_desc("deviation [m]")
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(boxed)?;
+    let mut c = timeline_chart(
+        area,
+        "tracker's deviation from the plan it flies",
+        (t0, t1),
+        -d_max..d_max,
+        "deviation [m]",
+    )?;
     let blue = RGBColor(31, 119, 180);
     c.draw_series(LineSeries::new(
         flight.samples.iter().map(|s| (s.t, s.deviation.cross_m)),
@@ -392,29 +472,29 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
         .map_err(boxed)?;
     }
     replan_lines(&mut c, flight, (-d_max, d_max))?;
-    legend(&mut c)?;
+    legend(&mut c)
+}
 
-    // 3. Plans: which one is flown, and the compute time of each. Plan ids need not start
-    // at 1 (a resumed flight, a restarted planner).
+/// Panel 3: the plans, which one is flown and the compute time of each. Plan ids need not
+/// start at 1 (a resumed flight, a restarted planner).
+fn plans_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    flight: &Flight,
+    span: (f64, f64),
+) -> PlotResult<()>
+where
+    DB::ErrorType: 'static,
+{
     let ids = flight.plans.iter().map(|p| p.plan.plan_id);
     let id_lo = ids.clone().min().unwrap_or(1) as f64;
     let id_hi = ids.max().unwrap_or(1) as f64;
-    let mut c = ChartBuilder::on(&panels[2])
-        .margin(12)
-        .x_label_area_size(36)
-        .y_label_area_size(70)
-        .caption(
-            "plan flown (bars: trigger time to start; label: trigger, compute time, quality)",
-            ("sans-serif", 18),
-        )
-        .build_cartesian_2d(t0..t1, (id_lo - 1.0)..(id_hi + 1.0))
-        .map_err(boxed)?;
-    c.configure_mesh()
-        .x_desc("mission time [s]")
-        .y_desc("plan id")
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(boxed)?;
+    let mut c = timeline_chart(
+        area,
+        "plan flown (bars: trigger time to start; label: trigger, compute time, quality)",
+        span,
+        (id_lo - 1.0)..(id_hi + 1.0),
+        "plan id",
+    )?;
     c.draw_series(LineSeries::new(
         flight.samples.iter().map(|s| (s.t, s.plan_id as f64)),
         BLACK.stroke_width(2),
@@ -444,7 +524,6 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
         )))
         .map_err(boxed)?;
     }
-    root.present().map_err(boxed)?;
     Ok(())
 }
 
