@@ -1,7 +1,7 @@
 //! Benchmark of the seeds + particle swarm (issue 5) on every canonical scenario: wall
 //! time per run (median and p95 over `SWARM_RUNS` runs with different seeds, default 20),
 //! the swarm's best cost and objective against the reference optimum
-//! (`../shared/reference/costs.toml`, when present), the spread of the objective across
+//! (`tools/judge/costs.toml`), the spread of the objective across
 //! seeds, and the best path's target and end pass distances. Numbers and the command are
 //! in `docs/BENCHMARKS.md` (its swarm section).
 //!
