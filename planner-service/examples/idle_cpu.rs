@@ -62,6 +62,7 @@ fn main() {
         vehicle_id: vehicle.clone(),
         ..ServiceConfig::default()
     };
+    wingman_ipc::logging::init();
     let service = ServiceThread::start(config).expect("start the service");
 
     // A minimal harness: the world and the tasking, a wake-up, then the first plan.

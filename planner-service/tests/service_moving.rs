@@ -20,6 +20,7 @@ fn a_moving_threat_is_tracked_and_its_t_r_schedules_a_replan() {
     // swarm-only plan within it: the quality is not checked here.)
     cfg.budget.plan_3d_ms = 5000;
     let budget_s = cfg.budget.plan_3d_ms as f64 * 1e-3;
+    wingman_ipc::logging::init();
     let service = ServiceThread::start(cfg).expect("start the service");
     let mut h = FakeHarness::new(&v);
     assert!(h.wait_until(Duration::from_secs(20), |h| h.status.is_some()));

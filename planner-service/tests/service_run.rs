@@ -21,6 +21,7 @@ const PLAN_WAIT: Duration = Duration::from_secs(120);
 /// time 0 and waits for the first plan.
 fn first_plan(tag: &str) -> (ServiceThread, FakeHarness) {
     let v = vehicle(tag);
+    wingman_ipc::logging::init();
     let service = ServiceThread::start(test_config(&v)).expect("start the service");
     let mut h = FakeHarness::new(&v);
     first_plan_of(&mut h, "2d-min-time-avoidable", PLAN_WAIT);

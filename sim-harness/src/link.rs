@@ -1,22 +1,17 @@
-//! The harness's iceoryx2 ports to the planner, opened through `wingman_ipc`
-//! (the planner's own QoS helpers, so both sides agree): publishers of every input, one
-//! header sequence counter across them, subscribers of `plan` and `status`, the
-//! `wake/planner` notifier and the `wake/harness` listener. Every message sent or taken
-//! goes into the flight log.
+//! The harness's iceoryx2 ports to the planner, `wingman_ipc::ClientPorts` (the planner's
+//! own QoS helpers, so both sides agree): publishers of every input, subscribers of `plan`
+//! and `status`, the `wake/planner` notifier and the `wake/harness` listener; with one
+//! header sequence counter across the inputs. Every message sent or taken goes into the
+//! flight log.
 
 use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
-use iceoryx2::port::listener::Listener;
-use iceoryx2::port::notifier::Notifier;
-use iceoryx2::port::publisher::Publisher;
-use iceoryx2::port::subscriber::Subscriber;
-use iceoryx2::port::update_connections::UpdateConnections;
 use wingman_interfaces::{
     Header, LeadRoute, LeadState, Message, OwnshipState, Plan, PlannerState, PlannerStatus,
-    SENDER_HARNESS, Service, Tasking, ThreatReport, TrackFix, Wire,
+    SENDER_HARNESS, Tasking, ThreatReport, TrackFix, Wire,
 };
-use wingman_ipc::{self as ipc, Ipc, IpcError};
+use wingman_ipc::{self as ipc, ClientPorts, Ipc, IpcError};
 
 use crate::flight_log::{Direction, Entry, Kind, LogWriter};
 
@@ -46,16 +41,7 @@ pub struct Received {
 
 /// The harness's side of the services of one vehicle.
 pub struct PlannerLink {
-    tasking: Publisher<Ipc, Tasking, ()>,
-    route: Publisher<Ipc, LeadRoute, ()>,
-    lead_state: Publisher<Ipc, LeadState, ()>,
-    threats: Publisher<Ipc, ThreatReport, ()>,
-    tracks: Publisher<Ipc, TrackFix, ()>,
-    ownship: Publisher<Ipc, OwnshipState, ()>,
-    plan: Subscriber<Ipc, Plan, ()>,
-    status: Subscriber<Ipc, PlannerStatus, ()>,
-    wake: Notifier<Ipc>,
-    listener: Listener<Ipc>,
+    ports: ClientPorts,
     /// Header sequence of the last input sent (one counter over every input service).
     sequence: u64,
     /// Mission time stamped on the next input, s.
@@ -72,7 +58,9 @@ macro_rules! sender {
         /// returns its sequence.
         pub fn $name(&mut self, mut m: $ty) -> Result<u64, LinkError> {
             m.header = self.next_header();
-            self.$port
+            self.ports
+                .inputs
+                .$port
                 .send_copy(m)
                 .map_err(|e| port_err(concat!("send ", stringify!($ty)), e))?;
             self.log.message(Direction::ToPlanner, self.mission_s, &m);
@@ -85,21 +73,8 @@ impl PlannerLink {
     /// Opens every port of `vehicle_id` on a node of its own.
     pub fn open(vehicle_id: &str, log: LogWriter) -> Result<PlannerLink, LinkError> {
         let node = ipc::node(&format!("wingman-harness-{vehicle_id}"), false)?;
-        let v = vehicle_id;
         Ok(PlannerLink {
-            tasking: ipc::publisher(&ipc::open_publish_subscribe(&node, v)?)?,
-            route: ipc::publisher(&ipc::open_publish_subscribe(&node, v)?)?,
-            lead_state: ipc::publisher(&ipc::open_publish_subscribe(&node, v)?)?,
-            threats: ipc::publisher(&ipc::open_publish_subscribe(&node, v)?)?,
-            tracks: ipc::publisher(&ipc::open_publish_subscribe(&node, v)?)?,
-            ownship: ipc::publisher(&ipc::open_publish_subscribe(&node, v)?)?,
-            plan: ipc::subscriber(&ipc::open_publish_subscribe(&node, v)?)?,
-            status: ipc::subscriber(&ipc::open_publish_subscribe(&node, v)?)?,
-            wake: ipc::notifier(
-                &ipc::open_event(&node, v, Service::PlannerWake)?,
-                ipc::WAKE_INPUT,
-            )?,
-            listener: ipc::listener(&ipc::open_event(&node, v, Service::HarnessWake)?)?,
+            ports: ClientPorts::open(&node, vehicle_id)?,
             sequence: 0,
             mission_s: 0.0,
             last_status: None,
@@ -158,7 +133,9 @@ impl PlannerLink {
             ($port:ident, $ty:ty) => {{
                 let m: $ty = <$ty as Wire>::read_from_bytes(bytes)
                     .map_err(|e| port_err("decode a logged message", e))?;
-                self.$port
+                self.ports
+                    .inputs
+                    .$port
                     .send_copy(m)
                     .map_err(|e| port_err("send a logged message", e))?;
                 m.header.sequence
@@ -180,17 +157,13 @@ impl PlannerLink {
     /// Hands the publishers' history to subscribers that joined since (a restarted
     /// planner); called every step.
     pub fn refresh(&self) {
-        let _ = self.tasking.update_connections();
-        let _ = self.route.update_connections();
-        let _ = self.lead_state.update_connections();
-        let _ = self.threats.update_connections();
-        let _ = self.tracks.update_connections();
-        let _ = self.ownship.update_connections();
+        self.ports.inputs.update_connections();
     }
 
     /// Wakes the planner (after publishing a step's inputs).
     pub fn wake(&self) -> Result<(), LinkError> {
-        self.wake
+        self.ports
+            .wake
             .notify()
             .map(|_| ())
             .map_err(|e| port_err("notify wake/planner", e))
@@ -200,9 +173,9 @@ impl PlannerLink {
     /// invalid one is counted and dropped) and logged.
     pub fn poll(&mut self) -> Result<Received, LinkError> {
         let mut out = Received::default();
-        let _ = self.plan.update_connections();
-        let _ = self.status.update_connections();
+        self.ports.update_subscriptions();
         while let Some(sample) = self
+            .ports
             .plan
             .receive()
             .map_err(|e| port_err("receive a plan", e))?
@@ -226,6 +199,7 @@ impl PlannerLink {
             }
         }
         while let Some(sample) = self
+            .ports
             .status
             .receive()
             .map_err(|e| port_err("receive a status", e))?
@@ -246,7 +220,8 @@ impl PlannerLink {
 
     /// Waits on `wake/harness` (at most `timeout`) for the planner to publish something.
     pub fn wait(&self, timeout: Duration) -> Result<(), LinkError> {
-        self.listener
+        self.ports
+            .listener
             .timed_wait(|_| {}, timeout)
             .map(|_| ())
             .map_err(|e| port_err("wait on wake/harness", e))

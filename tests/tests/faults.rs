@@ -188,12 +188,12 @@ fn a_rogue_publisher_of_malformed_messages_is_rejected_and_counted() {
     let total =
         (tasks.len() + routes.len() + leads.len() + threats.len() + fixes.len() + owns.len())
             as u64;
-    send_batches(&mut h, &mut p, &rogue.tasking, &tasks);
-    send_batches(&mut h, &mut p, &rogue.route, &routes);
-    send_batches(&mut h, &mut p, &rogue.lead_state, &leads);
-    send_batches(&mut h, &mut p, &rogue.threats, &threats);
-    send_batches(&mut h, &mut p, &rogue.tracks, &fixes);
-    send_batches(&mut h, &mut p, &rogue.ownship, &owns);
+    send_batches(&mut h, &mut p, &rogue.ports.tasking, &tasks);
+    send_batches(&mut h, &mut p, &rogue.ports.route, &routes);
+    send_batches(&mut h, &mut p, &rogue.ports.lead_state, &leads);
+    send_batches(&mut h, &mut p, &rogue.ports.threats, &threats);
+    send_batches(&mut h, &mut p, &rogue.ports.tracks, &fixes);
+    send_batches(&mut h, &mut p, &rogue.ports.ownship, &owns);
     assert!(
         h.wait_until(WAIT, |h| h.status.is_some_and(|s| s.messages_rejected
             - before.messages_rejected

@@ -46,7 +46,7 @@ fn send(r: &Rogue, service: usize, bytes: &[u8], word: Option<usize>) -> bool {
         ($port:ident, $valid:expr) => {
             match build($valid, bytes, word) {
                 Some(m) => {
-                    send_invalid(&r.$port, m);
+                    send_invalid(&r.ports.$port, m);
                     true
                 }
                 None => false,
@@ -101,6 +101,7 @@ fn send(r: &Rogue, service: usize, bytes: &[u8], word: Option<usize>) -> bool {
 #[test]
 fn arbitrary_messages_to_a_running_service_are_rejected_without_effect() {
     let v = vehicle("fuzz");
+    wingman_ipc::logging::init();
     let service = ServiceThread::start(test_config(&v)).expect("start the service");
     let mut h = FakeHarness::new(&v);
     let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();

@@ -3,6 +3,7 @@
 //!
 //! - this module: the iceoryx2 services, their quality of service, the wake event ids, the
 //!   port helpers and the dead-node clean-up;
+//! - [`client`]: a client's side of a vehicle's services (the harness's, the tests');
 //! - [`config`]: the planner's configuration file, `planner.toml` (the harness writes one
 //!   for every planner it starts);
 //! - [`logging`]: the log set-up of both binaries.
@@ -24,9 +25,11 @@
 //! and the planner's solve thread notifies it ([`WAKE_SOLVER`]) after each plan; the
 //! planner notifies `wake/harness` after each plan or status.
 
+pub mod client;
 pub mod config;
 pub mod logging;
 
+pub use client::{ClientPorts, InputPublishers};
 pub use config::{ConfigError, ServiceConfig};
 
 use std::time::Duration;

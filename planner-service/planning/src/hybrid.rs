@@ -103,6 +103,9 @@ pub struct Planner {
     /// The KKT workspaces of recent solves, kept for solves of the same pattern, and the
     /// factorisations' counters: the planner's own, shared by its threads.
     kkt: Arc<KktCache>,
+    /// The settings last validated: a service plans with the same ones every time, and
+    /// their check (extra solver options are tried on a solver) is not repeated.
+    validated: Option<PlannerSettings>,
 }
 
 impl Planner {
@@ -120,7 +123,17 @@ impl Planner {
             timing: [SolveTiming::prior(false), SolveTiming::prior(true)],
             stage: [StageTiming::prior(false), StageTiming::prior(true)],
             kkt,
+            validated: None,
         }
+    }
+
+    /// Validates `settings` unless they are the ones validated last.
+    fn check(&mut self, settings: &PlannerSettings) -> Result<(), PlannerSettingsError> {
+        if self.validated.as_ref() != Some(settings) {
+            settings.validate()?;
+            self.validated = Some(settings.clone());
+        }
+        Ok(())
     }
 
     /// The planner's pool of KKT workspaces and its factorisations' counters.
@@ -142,7 +155,7 @@ impl Planner {
         deadline: Deadline<'static>,
     ) -> Result<PlanOutcome, PlanError> {
         problem.validate()?;
-        settings.validate()?;
+        self.check(settings)?;
         let clock = deadline.clock();
         let started = clock.now();
         let mut times = StageTimes::default();

@@ -66,13 +66,13 @@ fn a_plan_with_bad_settings_fails_before_it_starts() {
     let mut settings = PlannerSettings::default();
     settings.ranking_nlp = settings.ranking_nlp.with_extra("no_such_option", "1");
     let clock: &'static ManualClock = Box::leak(Box::new(ManualClock::new()));
-    let err = Planner::new(&settings)
-        .plan(
-            &problem,
-            &settings,
-            Deadline::after(clock, Duration::from_secs(10)),
-        )
+    let mut planner = Planner::new(&settings);
+    let deadline = || Deadline::after(clock, Duration::from_secs(10));
+    let err = planner
+        .plan(&problem, &settings, deadline())
         .expect_err("bad settings");
+    // A refusal is not remembered as checked: the same settings are refused again.
+    assert!(planner.plan(&problem, &settings, deadline()).is_err());
     assert!(
         matches!(
             err,

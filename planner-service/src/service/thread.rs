@@ -16,9 +16,10 @@ pub struct ServiceThread {
 }
 
 impl ServiceThread {
-    /// Starts the service with `config` (its own monotonic clock, no signal handling).
+    /// Starts the service with `config` (its own monotonic clock, no signal handling). Its
+    /// log events go to whatever `tracing` subscriber the caller installed (none: they
+    /// are dropped; `wingman_ipc::logging::init` installs the binaries' one).
     pub fn start(config: ServiceConfig) -> std::io::Result<ServiceThread> {
-        wingman_ipc::logging::init();
         let shutdown = Shutdown::new();
         let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
         let options = RunOptions {

@@ -7,13 +7,8 @@
 use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
-use iceoryx2::port::listener::Listener;
-use iceoryx2::port::notifier::Notifier;
-use iceoryx2::port::publisher::Publisher;
-use iceoryx2::port::subscriber::Subscriber;
-use iceoryx2::port::update_connections::UpdateConnections;
 use wingman_interfaces::*;
-use wingman_ipc::{self as ipc, Ipc, ServiceConfig};
+use wingman_ipc::{self as ipc, ClientPorts, Ipc, ServiceConfig};
 
 /// A configuration for tests: generous budgets (a debug build plans ~40x slower than a
 /// release one; a converged plan returns early anyway), a fast heartbeat, short spacing.
@@ -34,16 +29,7 @@ pub fn test_config(vehicle_id: &str) -> ServiceConfig {
 /// The harness side of the services.
 pub struct FakeHarness {
     pub vehicle: String,
-    tasking: Publisher<Ipc, Tasking, ()>,
-    route: Publisher<Ipc, LeadRoute, ()>,
-    lead_state: Publisher<Ipc, LeadState, ()>,
-    threats: Publisher<Ipc, ThreatReport, ()>,
-    tracks: Publisher<Ipc, TrackFix, ()>,
-    ownship: Publisher<Ipc, OwnshipState, ()>,
-    plan: Subscriber<Ipc, Plan, ()>,
-    status_sub: Subscriber<Ipc, PlannerStatus, ()>,
-    wake: Notifier<Ipc>,
-    listener: Listener<Ipc>,
+    ports: ClientPorts,
     /// Header sequence of the last input sent (one counter over all inputs).
     pub sequence: u64,
     /// Mission time of the next input, ns.
@@ -57,23 +43,8 @@ pub struct FakeHarness {
 impl FakeHarness {
     pub fn new(vehicle: &str) -> FakeHarness {
         let node = ipc::node(&format!("fake-harness-{vehicle}"), false).unwrap();
-        let v = vehicle;
         FakeHarness {
-            tasking: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            route: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            lead_state: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            threats: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            tracks: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            ownship: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            plan: ipc::subscriber(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            status_sub: ipc::subscriber(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            wake: ipc::notifier(
-                &ipc::open_event(&node, v, Service::PlannerWake).unwrap(),
-                ipc::WAKE_INPUT,
-            )
-            .unwrap(),
-            listener: ipc::listener(&ipc::open_event(&node, v, Service::HarnessWake).unwrap())
-                .unwrap(),
+            ports: ClientPorts::open(&node, vehicle).unwrap(),
             vehicle: vehicle.to_string(),
             sequence: 0,
             mission_ns: 0,
@@ -96,59 +67,54 @@ impl FakeHarness {
 
     pub fn send_tasking(&mut self, mut m: Tasking) -> u64 {
         m.header = self.header();
-        self.tasking.send_copy(m).unwrap();
+        self.ports.inputs.tasking.send_copy(m).unwrap();
         m.header.sequence
     }
 
     pub fn send_route(&mut self, mut m: LeadRoute) -> u64 {
         m.header = self.header();
-        self.route.send_copy(m).unwrap();
+        self.ports.inputs.route.send_copy(m).unwrap();
         m.header.sequence
     }
 
     pub fn send_lead_state(&mut self, mut m: LeadState) -> u64 {
         m.header = self.header();
-        self.lead_state.send_copy(m).unwrap();
+        self.ports.inputs.lead_state.send_copy(m).unwrap();
         m.header.sequence
     }
 
     pub fn send_threat(&mut self, mut m: ThreatReport) -> u64 {
         m.header = self.header();
-        self.threats.send_copy(m).unwrap();
+        self.ports.inputs.threats.send_copy(m).unwrap();
         m.header.sequence
     }
 
     /// Sends a threat report as it is, header included (for invalid messages).
     pub fn send_threat_raw(&mut self, m: ThreatReport) {
-        self.threats.send_copy(m).unwrap();
+        self.ports.inputs.threats.send_copy(m).unwrap();
     }
 
     pub fn send_fix(&mut self, mut m: TrackFix) -> u64 {
         m.header = self.header();
-        self.tracks.send_copy(m).unwrap();
+        self.ports.inputs.tracks.send_copy(m).unwrap();
         m.header.sequence
     }
 
     pub fn send_ownship(&mut self, mut m: OwnshipState) -> u64 {
         m.header = self.header();
-        self.ownship.send_copy(m).unwrap();
+        self.ports.inputs.ownship.send_copy(m).unwrap();
         m.header.sequence
     }
 
     /// Hands the publishers' history to subscribers that joined since their last send (a
     /// restarted planner), as the harness does every step.
     pub fn refresh(&self) {
-        let _ = self.tasking.update_connections();
-        let _ = self.route.update_connections();
-        let _ = self.lead_state.update_connections();
-        let _ = self.threats.update_connections();
-        let _ = self.tracks.update_connections();
-        let _ = self.ownship.update_connections();
+        self.ports.inputs.update_connections();
     }
 
     /// Wakes the planner (after publishing).
     pub fn wake(&self) {
-        self.wake.notify().unwrap();
+        self.ports.wake.notify().unwrap();
     }
 
     /// Waits for the planner's first heartbeat, sends `threats` and `tasking` at mission
@@ -177,8 +143,8 @@ impl FakeHarness {
 
     /// Takes the plans and statuses published so far.
     pub fn poll(&mut self) {
-        let _ = self.plan.update_connections();
-        while let Some(sample) = self.plan.receive().unwrap() {
+        self.ports.update_subscriptions();
+        while let Some(sample) = self.ports.plan.receive().unwrap() {
             let mut b = Box::<Plan>::new_uninit();
             // SAFETY: copies one initialised `Plan` into the box's room for one.
             let b = unsafe {
@@ -188,7 +154,7 @@ impl FakeHarness {
             b.validate().expect("the planner publishes valid plans");
             self.plans.push(b);
         }
-        while let Some(sample) = self.status_sub.receive().unwrap() {
+        while let Some(sample) = self.ports.status.receive().unwrap() {
             let s = *sample.payload();
             s.validate().expect("the planner publishes valid statuses");
             self.status = Some(s);
@@ -207,6 +173,7 @@ impl FakeHarness {
                 return false;
             }
             let _ = self
+                .ports
                 .listener
                 .timed_wait(|_| {}, Duration::from_millis(50))
                 .unwrap();

@@ -2,17 +2,12 @@
 //! planner that sends whatever it is given (the fault and fuzz tests).
 
 use wingman_interfaces::*;
-use wingman_ipc::{self as ipc, Ipc};
+use wingman_ipc::{self as ipc, InputPublishers, Ipc};
 
 /// A publisher of every input service that sends whatever bytes it is given (a rogue
 /// process on the vehicle's services).
 pub struct Rogue {
-    pub tasking: iceoryx2::port::publisher::Publisher<Ipc, Tasking, ()>,
-    pub route: iceoryx2::port::publisher::Publisher<Ipc, LeadRoute, ()>,
-    pub lead_state: iceoryx2::port::publisher::Publisher<Ipc, LeadState, ()>,
-    pub threats: iceoryx2::port::publisher::Publisher<Ipc, ThreatReport, ()>,
-    pub tracks: iceoryx2::port::publisher::Publisher<Ipc, TrackFix, ()>,
-    pub ownship: iceoryx2::port::publisher::Publisher<Ipc, OwnshipState, ()>,
+    pub ports: InputPublishers,
     _node: iceoryx2::node::Node<Ipc>,
 }
 
@@ -20,12 +15,7 @@ impl Rogue {
     pub fn new(v: &str) -> Rogue {
         let node = ipc::node(&format!("rogue-{v}"), false).unwrap();
         Rogue {
-            tasking: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            route: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            lead_state: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            threats: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            tracks: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
-            ownship: ipc::publisher(&ipc::open_publish_subscribe(&node, v).unwrap()).unwrap(),
+            ports: InputPublishers::open(&node, v).unwrap(),
             _node: node,
         }
     }

@@ -26,7 +26,7 @@ impl Default for MeshSettings {
 }
 
 /// Settings of the whole planner.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PlannerSettings {
     pub swarm: SwarmSettings,
     pub mesh: MeshSettings,
