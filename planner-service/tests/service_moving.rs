@@ -19,6 +19,7 @@ fn a_moving_threat_is_tracked_and_its_t_r_schedules_a_replan() {
     // to the next t_r every plan would be due at once. (A debug build may return a
     // swarm-only plan within it: the quality is not checked here.)
     cfg.budget.plan_3d_ms = 5000;
+    cfg.budget.replan_3d_ms = 5000;
     let budget_s = cfg.budget.plan_3d_ms as f64 * 1e-3;
     wingman_ipc::logging::init();
     let service = ServiceThread::start(cfg).expect("start the service");

@@ -92,7 +92,8 @@ fn config_file(tag: &str) -> PathBuf {
     let path = std::env::temp_dir().join(format!("wingman-{}-{tag}.toml", std::process::id()));
     // No wait for an ownship state before a first plan: `Planning` then means a plan in
     // flight (the restart test sends its ownship state with the history anyway).
-    let text = "[budget]\nplan_2d_ms = 20000\nplan_3d_ms = 20000\nduty_cycle = 1.0\n\
+    let text = "[budget]\nplan_2d_ms = 20000\nplan_3d_ms = 20000\nreplan_2d_ms = 20000\n\
+                replan_3d_ms = 20000\nduty_cycle = 1.0\n\
                 duty_window_ms = 60000\n\n[status]\nheartbeat_ms = 100\n\n\
                 [triggers]\nfirst_plan_wait_ms = 0\n";
     std::fs::write(&path, text).unwrap();
@@ -384,7 +385,7 @@ fn the_unit_file_and_the_deployment_doc_match_the_binary() {
         .parse()
         .unwrap();
     let cfg = wingman_ipc::ServiceConfig::load(repo().join("planner.toml")).unwrap();
-    let largest_s = cfg.budget.plan_2d_ms.max(cfg.budget.plan_3d_ms) as f64 / 1e3;
+    let largest_s = cfg.budget.largest_ms() as f64 / 1e3;
     assert!(
         stop_s > largest_s + 2.0,
         "TimeoutStopSec={stop_s} <= {largest_s} s + 2 s"

@@ -159,6 +159,8 @@ pub fn harness_planner_config(vehicle_id: &str) -> ServiceConfig {
     };
     c.budget.plan_2d_ms = 2_000;
     c.budget.plan_3d_ms = 6_000;
+    c.budget.replan_2d_ms = 2_000;
+    c.budget.replan_3d_ms = 6_000;
     c.budget.duty_cycle = 1.0;
     c.budget.duty_window_ms = 60_000;
     c.status.heartbeat_ms = 200;

@@ -151,7 +151,8 @@ fn an_external_planner_is_flown_against_the_same_way() {
     let config = dir.0.join("planner.toml");
     std::fs::write(
         &config,
-        "[budget]\nplan_2d_ms = 2000\nplan_3d_ms = 6000\nduty_cycle = 1.0\nduty_window_ms = 60000\n",
+        "[budget]\nplan_2d_ms = 2000\nplan_3d_ms = 6000\nreplan_2d_ms = 2000\nreplan_3d_ms = 6000\n\
+         duty_cycle = 1.0\nduty_window_ms = 60000\n",
     )
     .unwrap();
     let planner = Command::new(binary("wingman-planner"))

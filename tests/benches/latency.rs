@@ -661,9 +661,9 @@ fn planner_toml(dir: &Path, o: &Options) -> PathBuf {
     std::fs::write(
         &p,
         format!(
-            "[budget]\nplan_2d_ms = {}\nplan_3d_ms = {}\nmin_spacing_ms = {MIN_SPACING_MS}\n\
-             duty_cycle = 1.0\nduty_window_ms = {DUTY_WINDOW_MS}\n\n[solver]\nthreads = \
-             {SOLVER_THREADS}\n{}",
+            "[budget]\nplan_2d_ms = {0}\nplan_3d_ms = {1}\nreplan_2d_ms = {0}\nreplan_3d_ms = {1}\n\
+             min_spacing_ms = {MIN_SPACING_MS}\nduty_cycle = 1.0\nduty_window_ms = {DUTY_WINDOW_MS}\n\n\
+             [solver]\nthreads = {SOLVER_THREADS}\n{2}",
             o.budget_2d_ms,
             o.budget_3d_ms,
             o.message_slice_us

@@ -42,18 +42,36 @@ pub struct ServiceConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BudgetConfig {
-    /// Deadline of a 2-D plan, ms. A re-plan commits this long after it starts (mission
-    /// time when it is started, which is later than its trigger if the compute gate
-    /// deferred it).
+    /// Deadline of a 2-D plan made from scratch, ms: the take-off plan, a new tasking, a
+    /// restart (nothing in flight to start from). A plan commits this long after it
+    /// starts (mission time when it is started, which is later than its trigger if the
+    /// compute gate deferred it).
     pub plan_2d_ms: u64,
-    /// Deadline of a 3-D plan, ms.
+    /// Deadline of a 3-D plan made from scratch, ms.
     pub plan_3d_ms: u64,
+    /// Deadline of a 2-D re-plan of the plan in flight (a pop-up, a moving threat's
+    /// scheduled re-plan, a deviation, a lead-route change, an expiry), ms: the
+    /// aircraft's reaction time. The re-plan starts from the plan in flight and then
+    /// searches globally with the time left.
+    pub replan_2d_ms: u64,
+    /// Deadline of a 3-D re-plan of the plan in flight, ms.
+    pub replan_3d_ms: u64,
     /// Least wall-clock time between the starts of two plans, ms.
     pub min_spacing_ms: u64,
     /// Share of one core the planner may spend planning over the sliding window (0–1].
     pub duty_cycle: f64,
     /// Length of the duty-cycle window, ms.
     pub duty_window_ms: u64,
+}
+
+impl BudgetConfig {
+    /// The largest of the budgets, ms.
+    pub fn largest_ms(&self) -> u64 {
+        self.plan_2d_ms
+            .max(self.plan_3d_ms)
+            .max(self.replan_2d_ms)
+            .max(self.replan_3d_ms)
+    }
 }
 
 /// When to re-plan (FORMULATION.md §6).
@@ -140,6 +158,8 @@ impl Default for BudgetConfig {
         BudgetConfig {
             plan_2d_ms: 500,
             plan_3d_ms: 2500,
+            replan_2d_ms: 100,
+            replan_3d_ms: 300,
             min_spacing_ms: 250,
             duty_cycle: 0.5,
             duty_window_ms: 10_000,
@@ -235,6 +255,12 @@ impl ServiceConfig {
         if b.plan_3d_ms == 0 {
             return bad("budget.plan_3d_ms", "must be positive".into());
         }
+        if b.replan_2d_ms == 0 {
+            return bad("budget.replan_2d_ms", "must be positive".into());
+        }
+        if b.replan_3d_ms == 0 {
+            return bad("budget.replan_3d_ms", "must be positive".into());
+        }
         if self.solver.threads == 0 {
             return bad("solver.threads", "must be at least 1".into());
         }
@@ -249,7 +275,7 @@ impl ServiceConfig {
         }
         let cap_ms = b.duty_cycle * b.duty_window_ms as f64;
         let threads = self.solver.threads;
-        let largest = b.plan_2d_ms.max(b.plan_3d_ms) as f64 * threads as f64;
+        let largest = b.largest_ms() as f64 * threads as f64;
         if cap_ms < largest {
             return bad(
                 "budget.duty_cycle",
@@ -311,11 +337,19 @@ impl ServiceConfig {
         Ok(())
     }
 
-    /// Compute budget of one plan of `model`.
+    /// Compute budget of one plan of `model` made from scratch.
     pub fn plan_budget(&self, model: Model) -> Duration {
         Duration::from_millis(match model {
             Model::TwoD => self.budget.plan_2d_ms,
             Model::ThreeD => self.budget.plan_3d_ms,
+        })
+    }
+
+    /// Compute budget of one re-plan of `model` from the plan in flight.
+    pub fn replan_budget(&self, model: Model) -> Duration {
+        Duration::from_millis(match model {
+            Model::TwoD => self.budget.replan_2d_ms,
+            Model::ThreeD => self.budget.replan_3d_ms,
         })
     }
 

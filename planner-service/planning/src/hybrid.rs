@@ -9,13 +9,16 @@
 //! `Optimal` (the NLP converged), `Feasible` (the NLP stopped early with its constraints
 //! within tolerance), `SwarmOnly` (the swarm's lifted path).
 
+mod deflect;
 mod nlp_stage;
 mod schedule;
 mod settings;
 mod timing;
+mod warm_start;
 
 use nlp_stage::{Finaled, NlpStage, Ranked, Solved};
 pub use settings::{MeshSettings, PlannerSettings, PlannerSettingsError};
+pub use warm_start::{FlyingPlan, WarmReport};
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -54,7 +57,28 @@ pub struct StageTimes {
     /// The part of `nlp` spent ranking the starts on the coarse mesh.
     pub ranking: Duration,
     pub export: Duration,
+    /// A re-plan's warm path (solving from the plan in flight), before the global search.
+    pub warm: Duration,
     pub total: Duration,
+}
+
+/// Which path made the plan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PlanPath {
+    /// The global search: seeds, swarm, ranked starts, finalists, refinement.
+    Global,
+    /// A re-plan's warm path: the plan in flight, cut at the new start and solved again.
+    Warm,
+}
+
+impl PlanPath {
+    /// The name in reports and logs.
+    pub fn name(self) -> &'static str {
+        match self {
+            PlanPath::Global => "global",
+            PlanPath::Warm => "warm",
+        }
+    }
 }
 
 /// What the NLP stage did.
@@ -89,6 +113,12 @@ pub struct PlanOutcome {
     pub swarm_iterations: usize,
     pub nlp: NlpReport,
     pub times: StageTimes,
+    /// Which path made the plan.
+    pub path: PlanPath,
+    /// A re-plan's warm path, when the problem continued the plan in flight.
+    pub warm: Option<WarmReport>,
+    /// From the plan's start to its first `Optimal` solution (`None`: it has none).
+    pub first_optimal: Option<Duration>,
 }
 
 /// The planner with its reusable workspace.
@@ -146,16 +176,65 @@ impl Planner {
         &self.swarm
     }
 
-    /// Plans `problem` by `deadline`. Never fails on a valid problem: at worst the swarm's
-    /// path comes back flagged `SwarmOnly`.
+    /// Plans `problem` by `deadline` from scratch (the global search alone). Never fails
+    /// on a valid problem: at worst the swarm's path comes back flagged `SwarmOnly`.
     pub fn plan(
         &mut self,
         problem: &Problem,
         settings: &PlannerSettings,
         deadline: Deadline<'static>,
     ) -> Result<PlanOutcome, PlanError> {
+        self.plan_from(problem, settings, deadline, None)
+    }
+
+    /// Re-plans `problem` by `deadline`, anytime: when `problem` continues the tasking of
+    /// `flying` (the plan in flight), first from that plan cut at `problem`'s start (the
+    /// warm path), then, with the time left, by the global search; the better of the two
+    /// by the deadline is returned. A problem of another tasking is planned as by
+    /// [`Planner::plan`].
+    pub fn replan(
+        &mut self,
+        problem: &Problem,
+        settings: &PlannerSettings,
+        deadline: Deadline<'static>,
+        flying: &FlyingPlan,
+    ) -> Result<PlanOutcome, PlanError> {
+        self.plan_from(problem, settings, deadline, Some(flying))
+    }
+
+    /// The warm path if `flying` is given and continued, then the global search; the
+    /// better plan.
+    fn plan_from(
+        &mut self,
+        problem: &Problem,
+        settings: &PlannerSettings,
+        deadline: Deadline<'static>,
+        flying: Option<&FlyingPlan>,
+    ) -> Result<PlanOutcome, PlanError> {
         problem.validate()?;
         self.check(settings)?;
+        let clock = deadline.clock();
+        let started = clock.now();
+        let warm = match flying.and_then(|f| f.guess_for(problem).map(|g| (f, g))) {
+            Some((flying, guess)) => Some(self.warm(problem, settings, deadline, flying, guess)?),
+            None => None,
+        };
+        let mut outcome = self.global(problem, settings, deadline)?;
+        if let Some(warm) = warm {
+            outcome.offer(warm);
+        }
+        outcome.times.total = clock.now().saturating_sub(started);
+        Ok(outcome)
+    }
+
+    /// The global search: seeds and swarm, the NLP stage over distinct starts, the
+    /// refinement of the winner.
+    fn global(
+        &mut self,
+        problem: &Problem,
+        settings: &PlannerSettings,
+        deadline: Deadline<'static>,
+    ) -> Result<PlanOutcome, PlanError> {
         let clock = deadline.clock();
         let started = clock.now();
         let mut times = StageTimes::default();
@@ -195,12 +274,8 @@ impl Planner {
             settings,
             starts: &starts,
             coarse: &coarse,
-            swarm_best: &sw.best,
-            reference: ExportSettings {
-                closed_loop: false,
-                max_step_s: settings.export.max_step_s / 2.0,
-                ..settings.export
-            },
+            fallback_start: &sw.best,
+            reference: reference_export(settings),
             timing,
             seen: Seen::default(),
             deadline,
@@ -218,6 +293,7 @@ impl Planner {
             report,
             accepted,
             cut,
+            first_optimal,
         } = gather(&stage, done, deadline)?;
         times.nlp = clock.now().saturating_sub(nlp_started);
 
@@ -249,6 +325,9 @@ impl Planner {
         times.export = clock.now().saturating_sub(export_started) + fallback_cost;
         times.total = clock.now().saturating_sub(started);
         Ok(PlanOutcome {
+            first_optimal: first_optimal.map(|t| t.saturating_sub(started)),
+            path: PlanPath::Global,
+            warm: None,
             quality,
             cost: trajectory_cost(problem, &trajectory),
             trajectory,
@@ -276,6 +355,16 @@ impl Planner {
             settings.threads,
             |tr| trajectory_cost(problem, tr),
         )
+    }
+}
+
+/// How solutions on the way are exported (to rank them, to start the next mesh from):
+/// densely, open loop.
+fn reference_export(settings: &PlannerSettings) -> ExportSettings {
+    ExportSettings {
+        closed_loop: false,
+        max_step_s: settings.export.max_step_s / 2.0,
+        ..settings.export
     }
 }
 
@@ -342,6 +431,8 @@ struct Gathered {
     report: NlpReport,
     accepted: Option<(Solved, Mesh)>,
     cut: bool,
+    /// When (stage clock) the first `Optimal` solution of a final or a round was there.
+    first_optimal: Option<Duration>,
 }
 
 /// The schedule's results in the step-by-step order (ranks, finals, rounds) into the
@@ -376,14 +467,26 @@ fn gather<'a>(
         report.ranking.push(path.map_or(f64::NAN, |p| p.0));
     }
     let mut accepted: Option<(Solved, Mesh)> = None;
+    // When the first `Optimal` solution (of a final or a round) was there.
+    let mut first_optimal: Option<Duration> = None;
+    let mut optimal_at = |solved: Option<&Solved>, at: Duration| {
+        if solved.is_some_and(|s| s.quality == Quality::Optimal) {
+            first_optimal = Some(first_optimal.map_or(at, |f| f.min(at)));
+        }
+    };
     for (k, f) in done.finals.into_iter().enumerate() {
-        let (result, fine) = match f {
-            Some(Finaled { result, mesh }) => (result, Some(mesh)),
-            None => (failed(), None),
+        let (result, fine, done_at) = match f {
+            Some(Finaled {
+                result,
+                mesh,
+                done_at,
+            }) => (result, Some(mesh), done_at),
+            None => (failed(), None, Duration::ZERO),
         };
         let (solved, iterations, status, _) = result?;
         report.iterations.push(iterations);
         report.status = Some(status);
+        optimal_at(solved.as_ref(), done_at);
         if done.winner == Some(k)
             && let (Some(s), Some(fine)) = (solved, fine)
         {
@@ -406,12 +509,13 @@ fn gather<'a>(
         } else {
             stage.round_after(round, current, mesh, false, None)
         };
-        let Some((result, next)) = next else {
+        let Some((result, next, done_at)) = next else {
             break;
         };
         let (solved, iterations, status, _) = result?;
         report.iterations.push(iterations);
         report.status = Some(status);
+        optimal_at(solved.as_ref(), done_at);
         match solved {
             Some(s) => accepted = Some((s, next)),
             None => break,
@@ -426,6 +530,7 @@ fn gather<'a>(
         report,
         accepted,
         cut,
+        first_optimal,
     })
 }
 

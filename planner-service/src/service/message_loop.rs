@@ -63,7 +63,7 @@ use wingman_interfaces::{
 use super::budget::{ComputeGate, GateSettings};
 use super::run::{RunOptions, ServiceError};
 use super::solver::Solver;
-use super::triggers::TriggerSet;
+use super::triggers::{self, TriggerSet};
 use super::world::World;
 use inputs::Logged;
 use lifecycle::{FirstPlan, PlanLifecycle};
@@ -317,15 +317,21 @@ impl MessageLoop {
         status
     }
 
-    /// Budget of a plan of the current tasking's model.
-    fn budget(&self) -> Duration {
+    /// Budget of a plan of the current tasking's model for the triggers `set`: a re-plan
+    /// of the plan in flight's, unless there is none or the triggers leave nothing of it
+    /// to start from (a first plan, a new tasking, a restart).
+    fn budget(&self, set: TriggerSet) -> Duration {
         let model = self
             .world
             .tasking
             .as_ref()
             .and_then(Tasking::model)
             .unwrap_or(Model::ThreeD);
-        self.cfg.plan_budget(model)
+        if self.has_plan && !triggers::from_scratch(set) {
+            self.cfg.replan_budget(model)
+        } else {
+            self.cfg.plan_budget(model)
+        }
     }
 }
 

@@ -17,7 +17,7 @@ use tracing::{error, info, info_span};
 use wingman_interfaces::Trigger;
 
 use wingman_planning::clock::{Clock, Deadline};
-use wingman_planning::hybrid::{PlanError, PlanOutcome, Planner, PlannerSettings};
+use wingman_planning::hybrid::{FlyingPlan, PlanError, PlanOutcome, Planner, PlannerSettings};
 use wingman_planning::problem::Problem;
 
 /// What travels with a problem to the solver and back.
@@ -35,6 +35,9 @@ pub struct Ticket {
     pub targets_from: usize,
     /// Revision of the tasking the problem was built from.
     pub tasking_revision: u32,
+    /// The plan in flight to re-plan from (its id), if any: the solve thread starts from
+    /// it when it made that plan and the problem continues its tasking.
+    pub warm_from: Option<u64>,
 }
 
 /// A plan to make.
@@ -213,6 +216,8 @@ fn solve_loop(
     wake: &mut dyn FnMut(),
 ) {
     let mut planner = Planner::new(settings);
+    // The last plan made, with its id: the plan in flight once the message thread took it.
+    let mut last: Option<(u64, FlyingPlan)> = None;
     let threads = settings.swarm.threads.max(settings.threads).max(1) as u32;
     for request in requests.iter() {
         let SolveRequest { problem, ticket } = request;
@@ -235,8 +240,13 @@ fn solve_loop(
         let started = clock.now();
         let deadline =
             Deadline::after(clock, ticket.budget).earlier(handover_margin(ticket.budget));
-        let outcome = match catch_unwind(AssertUnwindSafe(|| {
-            planner.plan(&problem, settings, deadline)
+        let flying = ticket
+            .warm_from
+            .and_then(|id| last.as_ref().filter(|(made, _)| *made == id))
+            .map(|(_, f)| f);
+        let outcome = match catch_unwind(AssertUnwindSafe(|| match flying {
+            Some(f) => planner.replan(&problem, settings, deadline, f),
+            None => planner.plan(&problem, settings, deadline),
         })) {
             Ok(r) => r.map_err(SolveError::from),
             Err(_) => {
@@ -260,6 +270,9 @@ fn solve_loop(
         match &outcome {
             Ok(o) => info!(
                 quality = o.quality.name(),
+                path = o.path.name(),
+                warm_ms = ms(o.times.warm),
+                first_optimal_ms = o.first_optimal.map_or(f64::NAN, ms),
                 cost = o.cost,
                 swarm_ms = ms(o.times.swarm),
                 nlp_ms = ms(o.times.nlp),
@@ -271,6 +284,12 @@ fn solve_loop(
             Err(e) => error!(error = %e, "no plan"),
         }
         drop(_entered);
+        if let Ok(o) = &outcome {
+            last = Some((
+                ticket.plan_id,
+                FlyingPlan::new(&problem, o.trajectory.clone()),
+            ));
+        }
         let result = SolveResult {
             problem,
             ticket,

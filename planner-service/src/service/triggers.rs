@@ -261,6 +261,15 @@ impl TriggerSet {
     }
 }
 
+/// Whether a plan for the triggers `set` is made from scratch: a first plan, a new
+/// tasking or a restart leave no plan in flight to start from (the other triggers re-plan
+/// it, with the re-plan budget).
+pub fn from_scratch(set: TriggerSet) -> bool {
+    [Trigger::Initial, Trigger::Tasking, Trigger::Restart]
+        .iter()
+        .any(|&t| set.contains(t))
+}
+
 /// Whether a re-plan for the pending triggers `set` starts from the ownship's state rather
 /// than from the state the current plan predicts: the aircraft left the plan (a deviation
 /// or a restart is pending, whatever trigger names the plan) or flies a safe hold.

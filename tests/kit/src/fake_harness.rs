@@ -19,6 +19,8 @@ pub fn test_config(vehicle_id: &str) -> ServiceConfig {
     };
     c.budget.plan_2d_ms = 20_000;
     c.budget.plan_3d_ms = 20_000;
+    c.budget.replan_2d_ms = 20_000;
+    c.budget.replan_3d_ms = 20_000;
     c.budget.min_spacing_ms = 250;
     c.budget.duty_cycle = 1.0;
     c.budget.duty_window_ms = 60_000;

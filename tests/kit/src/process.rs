@@ -185,7 +185,8 @@ pub fn planner_config(dir: &Path, plan_2d_ms: u64, plan_3d_ms: u64, extra: &str)
     std::fs::write(
         &p,
         format!(
-            "[budget]\nplan_2d_ms = {plan_2d_ms}\nplan_3d_ms = {plan_3d_ms}\nduty_cycle = 1.0\n\
+            "[budget]\nplan_2d_ms = {plan_2d_ms}\nplan_3d_ms = {plan_3d_ms}\n\
+             replan_2d_ms = {plan_2d_ms}\nreplan_3d_ms = {plan_3d_ms}\nduty_cycle = 1.0\n\
              duty_window_ms = 60000\n\n[status]\nheartbeat_ms = 100\n{extra}"
         ),
     )

@@ -157,11 +157,13 @@ pub(super) struct Ranked {
 pub(super) struct Finaled {
     pub(super) result: MeshSolveResult,
     pub(super) mesh: Mesh,
+    /// When it ended (stage clock).
+    pub(super) done_at: Duration,
 }
 
-/// A refinement round: its solve and mesh (`None`: the mesh needed no refinement and
-/// there was nothing to polish).
-pub(super) type Rounded = Option<(MeshSolveResult, Mesh)>;
+/// A refinement round: its solve, mesh and end (stage clock) (`None`: the mesh needed no
+/// refinement and there was nothing to polish).
+pub(super) type Rounded = Option<(MeshSolveResult, Mesh, Duration)>;
 
 /// The NLP stage of one plan, as [`schedule`] runs it.
 pub(super) struct NlpStage<'a> {
@@ -170,8 +172,9 @@ pub(super) struct NlpStage<'a> {
     pub(super) starts: &'a [Trajectory],
     /// The ranking mesh of each start.
     pub(super) coarse: &'a [Mesh],
-    /// The swarm's best (the fallback candidate's guess).
-    pub(super) swarm_best: &'a Trajectory,
+    /// The guess of the candidate solved when no start ranked: the swarm's best, or on
+    /// the warm path the plan in flight cut at the start.
+    pub(super) fallback_start: &'a Trajectory,
     /// How ranked solutions are exported: densely, open loop.
     pub(super) reference: ExportSettings,
     /// The solves' timing learned from recent plans.
@@ -239,7 +242,7 @@ impl NlpStage<'_> {
             start_x: same.then_some(current.x.as_slice()),
             cancel,
         });
-        Some((result, next))
+        Some((result, next, self.deadline.clock().now()))
     }
 }
 
@@ -294,10 +297,10 @@ impl schedule::Stage for NlpStage<'_> {
 
     fn finalist(&self, _c: usize, rank: Option<&Ranked>, cancel: Arc<AtomicBool>) -> Finaled {
         let settings = self.settings;
-        // A finalist starts from its coarse solution; the fallback from the swarm's best.
+        // A finalist starts from its coarse solution; the fallback from its own start.
         let (guess, coarse) = match rank.and_then(|r| r.path.as_ref().map(|p| (&p.1, r))) {
             Some((path, r)) => (path, accepted_of(&r.result)),
-            None => (self.swarm_best, None),
+            None => (self.fallback_start, None),
         };
         let mut mesh = Mesh::uniform(
             settings.mesh.points,
@@ -324,7 +327,11 @@ impl schedule::Stage for NlpStage<'_> {
             start_x: None,
             cancel: Some(cancel),
         });
-        Finaled { result, mesh }
+        Finaled {
+            result,
+            mesh,
+            done_at: self.deadline.clock().now(),
+        }
     }
 
     fn judge(&self, f: &Finaled) -> Option<(f64, bool)> {

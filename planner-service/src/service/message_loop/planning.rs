@@ -129,7 +129,8 @@ impl MessageLoop {
     /// Returns whether anything changed.
     pub(super) fn evaluate(&mut self) -> bool {
         let now = self.world.now_s();
-        let lead = self.budget().as_secs_f64();
+        // The time triggers re-plan the plan in flight: so far ahead they fire.
+        let lead = self.budget(TriggerSet::EMPTY).as_secs_f64();
         if self.first_plan_due()
             && !self.waiting_for_ownship()
             && let Some(t) = &self.world.tasking
@@ -227,7 +228,7 @@ impl MessageLoop {
             PlanLifecycle::Triggered(p) | PlanLifecycle::Deferred { pending: p, .. } => p,
             PlanLifecycle::Idle | PlanLifecycle::Planning { .. } => return false,
         };
-        let budget = self.budget();
+        let budget = self.budget(pending.set);
         let wall = self.clock.now();
         if !self.gate.admits(wall, budget) {
             if self.lifecycle.defer(self.gate.earliest_start(wall, budget)) {
@@ -274,6 +275,10 @@ impl MessageLoop {
             epoch: self.world.epoch,
             targets_from: splice.targets_from,
             tasking_revision: tasking.revision,
+            // The solve thread starts from the plan in flight if it made it and the
+            // problem continues its tasking.
+            warm_from: (self.has_plan && !triggers::from_scratch(set))
+                .then_some(self.current.plan_id),
         };
         match self.solver.submit(SolveRequest { problem, ticket }) {
             Ok(()) => {
