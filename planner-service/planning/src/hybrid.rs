@@ -219,12 +219,33 @@ impl Planner {
             Some((flying, guess)) => Some(self.warm(problem, settings, deadline, flying, guess)?),
             None => None,
         };
-        let mut outcome = self.global(problem, settings, deadline)?;
-        if let Some(warm) = warm {
-            outcome.offer(warm);
-        }
+        let mut outcome = match warm {
+            // The global search could only return the swarm's path, which an NLP plan
+            // beats: it is not run (both cores are left idle instead).
+            Some(warm) if warm.has_plan() && !self.global_nlp_fits(problem, settings, deadline) => {
+                PlanOutcome::of_warm(warm)
+            }
+            Some(warm) => {
+                let mut outcome = self.global(problem, settings, deadline)?;
+                outcome.offer(warm);
+                outcome
+            }
+            None => self.global(problem, settings, deadline)?,
+        };
         outcome.times.total = clock.now().saturating_sub(started);
         Ok(outcome)
+    }
+
+    /// Whether the global search's NLP stage fits in what `deadline` leaves, as recent plans
+    /// of `problem`'s model took it.
+    fn global_nlp_fits(
+        &self,
+        problem: &Problem,
+        settings: &PlannerSettings,
+        deadline: Deadline<'static>,
+    ) -> bool {
+        let model = usize::from(problem.dim() == 3);
+        nlp_possible(settings, deadline, self.timing[model], self.stage[model])
     }
 
     /// The global search: seeds and swarm, the NLP stage over distinct starts, the
@@ -378,15 +399,30 @@ fn swarm_deadline(
     timing: SolveTiming,
     stage_timing: StageTiming,
 ) -> Deadline<'static> {
-    let share = settings.swarm_share.clamp(0.0, 1.0);
-    let reserve = (stage_timing.fallback * 2).min(deadline.remaining() / 2);
-    let after_swarm = deadline.remaining().mul_f64(1.0 - share);
-    let nlp_possible = stage_timing.fits_the_stage(&timing, after_swarm.saturating_sub(reserve));
-    if nlp_possible {
-        deadline.share(share)
+    if nlp_possible(settings, deadline, timing, stage_timing) {
+        deadline.share(settings.swarm_share.clamp(0.0, 1.0))
     } else {
-        deadline.earlier(reserve)
+        deadline.earlier(fallback_reserve(deadline, stage_timing))
     }
+}
+
+/// Whether the NLP stage fits in what `deadline` leaves after the swarm's share and the
+/// fallback's reserve, as recent plans took it.
+fn nlp_possible(
+    settings: &PlannerSettings,
+    deadline: Deadline<'static>,
+    timing: SolveTiming,
+    stage_timing: StageTiming,
+) -> bool {
+    let share = settings.swarm_share.clamp(0.0, 1.0);
+    let after_swarm = deadline.remaining().mul_f64(1.0 - share);
+    let reserve = fallback_reserve(deadline, stage_timing);
+    stage_timing.fits_the_stage(&timing, after_swarm.saturating_sub(reserve))
+}
+
+/// The time kept for the fallback: twice its cost, at most half of what is left.
+fn fallback_reserve(deadline: Deadline<'static>, stage_timing: StageTiming) -> Duration {
+    (stage_timing.fallback * 2).min(deadline.remaining() / 2)
 }
 
 /// The swarm's lifted path, flown with the tracking law so that its controls replay onto

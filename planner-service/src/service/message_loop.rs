@@ -317,9 +317,15 @@ impl MessageLoop {
         status
     }
 
+    /// Whether a plan for the triggers `set` re-plans the plan in flight: there is one,
+    /// and the triggers leave something of it to start from (not a first plan, a new
+    /// tasking or a restart).
+    fn replans_in_flight(&self, set: TriggerSet) -> bool {
+        self.has_plan && !triggers::from_scratch(set)
+    }
+
     /// Budget of a plan of the current tasking's model for the triggers `set`: a re-plan
-    /// of the plan in flight's, unless there is none or the triggers leave nothing of it
-    /// to start from (a first plan, a new tasking, a restart).
+    /// of the plan in flight's, or a plan from scratch's.
     fn budget(&self, set: TriggerSet) -> Duration {
         let model = self
             .world
@@ -327,7 +333,7 @@ impl MessageLoop {
             .as_ref()
             .and_then(Tasking::model)
             .unwrap_or(Model::ThreeD);
-        if self.has_plan && !triggers::from_scratch(set) {
+        if self.replans_in_flight(set) {
             self.cfg.replan_budget(model)
         } else {
             self.cfg.plan_budget(model)

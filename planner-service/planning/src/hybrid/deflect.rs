@@ -12,6 +12,7 @@
 
 use std::f64::consts::PI;
 
+use crate::collocation::transcription::nearest_turn;
 use crate::problem::{Problem, Threats};
 use crate::threat::Superquadric;
 use crate::trajectory::Trajectory;
@@ -158,9 +159,7 @@ fn bent(guess: &Trajectory, c: &Crossing, shift: f64, h: usize) -> Trajectory {
             out.states[k][h] = out.states[k - 1][h];
             continue;
         }
-        let prev = out.states[k - 1][h];
-        let raw = dy.atan2(dx);
-        out.states[k][h] = raw + ((prev - raw) / (2.0 * PI)).round() * 2.0 * PI;
+        out.states[k][h] = nearest_turn(dy.atan2(dx), out.states[k - 1][h]);
     }
     // The last sample keeps its own heading (the end state may fix it).
     out.states[n - 1][h] = guess.states[n - 1][h];

@@ -4,7 +4,6 @@
 //! of the same tasking solves from it first; the global search follows with the time left
 //! (see [`super::Planner::replan`]).
 
-use std::f64::consts::TAU;
 use std::time::Duration;
 
 use wingman_interfaces::{Model, Objective, Quality};
@@ -13,11 +12,12 @@ use super::deflect;
 use super::nlp_stage::NlpStage;
 use super::timing::Seen;
 use super::{
-    Gathered, NlpReport, PlanError, PlanOutcome, PlanPath, Planner, PlannerSettings, gather,
-    ranking_meshes, reference_export, schedule, trajectory_cost,
+    Gathered, NlpReport, PlanError, PlanOutcome, PlanPath, Planner, PlannerSettings, StageTimes,
+    gather, ranking_meshes, reference_export, schedule, trajectory_cost,
 };
 use crate::clock::Deadline;
 use crate::collocation::export;
+use crate::collocation::transcription::nearest_turn;
 use crate::problem::{Problem, Threats};
 use crate::trajectory::Trajectory;
 
@@ -114,7 +114,35 @@ impl Planner {
     }
 }
 
+impl WarmPlan {
+    /// Whether the warm path has a plan (an accepted NLP solution).
+    pub(super) fn has_plan(&self) -> bool {
+        self.report.quality.is_some() && self.trajectory.is_some()
+    }
+}
+
 impl PlanOutcome {
+    /// The warm path's plan alone (no global search ran: no swarm path, no swarm time).
+    pub(super) fn of_warm(warm: WarmPlan) -> PlanOutcome {
+        let WarmPlan { report, trajectory } = warm;
+        PlanOutcome {
+            quality: report.quality.unwrap_or(Quality::SwarmOnly),
+            trajectory: trajectory.unwrap_or_default(),
+            cost: report.cost,
+            swarm_best: Trajectory::default(),
+            swarm_cost: f64::NAN,
+            swarm_iterations: 0,
+            nlp: report.nlp.clone(),
+            times: StageTimes {
+                warm: report.elapsed,
+                ..StageTimes::default()
+            },
+            path: PlanPath::Warm,
+            first_optimal: report.first_optimal,
+            warm: Some(report),
+        }
+    }
+
     /// Takes the warm path's plan if it is better than this (the global search's, which
     /// followed it): a solution of the NLP against the swarm's path, else the lower cost
     /// (a tie to the warm path). The warm path's report is kept either way.
@@ -205,7 +233,7 @@ impl FlyingPlan {
         let t0 = problem.t0;
         let (at_start, u0) = self.path.at(t0)?;
         let h = problem.heading_index();
-        let turns = ((problem.x0[h] - at_start[h]) / TAU).round() * TAU;
+        let turns = nearest_turn(at_start[h], problem.x0[h]) - at_start[h];
         let mut guess = Trajectory {
             phase_ends: self.path.phase_ends[dropped..].to_vec(),
             ..Trajectory::default()
@@ -233,6 +261,7 @@ impl FlyingPlan {
 mod tests {
     use super::*;
     use crate::scenario::bundled;
+    use std::f64::consts::TAU;
 
     /// A 2-D problem and a straight plan for it east at 200 m/s through its first target
     /// at t = 50 and on to t = 100.

@@ -277,8 +277,7 @@ impl MessageLoop {
             tasking_revision: tasking.revision,
             // The solve thread starts from the plan in flight if it made it and the
             // problem continues its tasking.
-            warm_from: (self.has_plan && !triggers::from_scratch(set))
-                .then_some(self.current.plan_id),
+            warm_from: self.replans_in_flight(set).then_some(self.current.plan_id),
         };
         match self.solver.submit(SolveRequest { problem, ticket }) {
             Ok(()) => {
