@@ -16,7 +16,9 @@ mod road;
 pub use expm::expm;
 pub use gauss_markov::{Discrete, DistanceStats, Estimate, GaussMarkov};
 pub use kalman::{Innovation, KalmanFilter};
-pub use moving_threat::{MovingEval, MovingThreat, Region, exposure_at, exposure_eval_at};
+pub use moving_threat::{
+    MovingEval, MovingThreat, Region, TabledRegion, exposure_at, exposure_eval_at, tabulate,
+};
 pub use road::{Road, RoadPoint};
 
 use thiserror::Error;

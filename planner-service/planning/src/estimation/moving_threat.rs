@@ -5,7 +5,7 @@
 use super::EstimationError;
 use super::gauss_markov::{Estimate, GaussMarkov};
 use super::road::Road;
-use crate::threat::{Eval, Superquadric, pow_abs};
+use crate::threat::{Eval, ExposureAcc, Superquadric, pow_abs};
 
 /// The keep-out region of a moving threat at one time, eqs. (6.5), (6.6).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -197,6 +197,47 @@ impl<const D: usize> MovingThreat<D> {
             .shape
             .cutoff_half_extents(crate::threat::cutoff_f(stiffness), true);
         (!reg.shape.outside_box(w, &half)).then_some(reg)
+    }
+}
+
+/// A moving threat's region at one time with its cut-off box and whether the threat is
+/// active then: what an evaluator that tables the regions over time keeps (the swarm's
+/// grid, the seeds' table), so that a point's exposure needs no propagation.
+#[derive(Debug, Clone, Copy)]
+pub struct TabledRegion<const D: usize> {
+    shape: Superquadric<D>,
+    half: [f64; D],
+    active: bool,
+}
+
+impl<const D: usize> TabledRegion<D> {
+    /// Folds the region's `F` at `w` into `acc` (with `stiffness`), as the exposure does:
+    /// only while the threat is active and `w` is inside its cut-off box.
+    #[inline]
+    pub fn fold_value_into(&self, w: &[f64; D], acc: &mut ExposureAcc<D>, stiffness: f64) {
+        if self.active && !self.shape.outside_box(w, &self.half) {
+            acc.fold_value(self.shape.f(w), stiffness);
+        }
+    }
+}
+
+/// Appends to `out`, for each time of `times` in turn, the region of every threat of
+/// `moving` with its cut-off box at `f_cut` (conservative, as the exposure's).
+pub fn tabulate<const D: usize>(
+    moving: &[MovingThreat<D>],
+    times: impl Iterator<Item = f64>,
+    f_cut: f64,
+    out: &mut Vec<TabledRegion<D>>,
+) {
+    for t in times {
+        for m in moving {
+            let r = m.region_at(t);
+            out.push(TabledRegion {
+                shape: r.shape,
+                half: r.shape.cutoff_half_extents(f_cut, true),
+                active: m.is_active(t),
+            });
+        }
     }
 }
 

@@ -1,7 +1,8 @@
 //! Moving threats' regions tabled at fixed times for the bisector scan and the polish.
 
+use crate::estimation::{TabledRegion, tabulate};
 use crate::problem::{Problem, Threats};
-use crate::threat::{ExposureAcc, Superquadric, cutoff_f};
+use crate::threat::{ExposureAcc, cutoff_f};
 
 /// Moving threats' regions at fixed times for the scan and the polish, which evaluate the
 /// exposure tens of thousands of times: propagating the estimate for every point would
@@ -12,8 +13,8 @@ pub(super) struct MovingTable {
     pub(super) step: f64,
     pub(super) times: usize,
     pub(super) per_time: usize,
-    pub(super) planar: Vec<(Superquadric<2>, [f64; 2], bool)>,
-    pub(super) spatial: Vec<(Superquadric<3>, [f64; 3], bool)>,
+    pub(super) planar: Vec<TabledRegion<2>>,
+    pub(super) spatial: Vec<TabledRegion<3>>,
 }
 
 impl MovingTable {
@@ -31,37 +32,26 @@ impl MovingTable {
             planar: Vec::new(),
             spatial: Vec::new(),
         };
+        let times = (0..times).map(|k| t0 + k as f64 * Self::STEP);
         match &problem.threats {
             Threats::Planar { layout, moving } if !moving.is_empty() => {
-                let fc = cutoff_f(layout.stiffness());
                 table.per_time = moving.len();
-                for k in 0..times {
-                    let t = t0 + k as f64 * Self::STEP;
-                    for m in moving {
-                        let r = m.region_at(t);
-                        table.planar.push((
-                            r.shape,
-                            r.shape.cutoff_half_extents(fc, true),
-                            m.is_active(t),
-                        ));
-                    }
-                }
+                tabulate(
+                    moving,
+                    times,
+                    cutoff_f(layout.stiffness()),
+                    &mut table.planar,
+                );
                 Some(table)
             }
             Threats::Spatial { layout, moving } if !moving.is_empty() => {
-                let fc = cutoff_f(layout.stiffness());
                 table.per_time = moving.len();
-                for k in 0..times {
-                    let t = t0 + k as f64 * Self::STEP;
-                    for m in moving {
-                        let r = m.region_at(t);
-                        table.spatial.push((
-                            r.shape,
-                            r.shape.cutoff_half_extents(fc, true),
-                            m.is_active(t),
-                        ));
-                    }
-                }
+                tabulate(
+                    moving,
+                    times,
+                    cutoff_f(layout.stiffness()),
+                    &mut table.spatial,
+                );
                 Some(table)
             }
             _ => None,
@@ -77,20 +67,16 @@ impl MovingTable {
                 let w = [p[0], p[1]];
                 let mut acc = ExposureAcc::<2>::new();
                 layout.fold_value_into(&w, &mut acc);
-                for (shape, half, active) in &self.planar[range] {
-                    if *active && !shape.outside_box(&w, half) {
-                        acc.fold_value(shape.f(&w), layout.stiffness());
-                    }
+                for r in &self.planar[range] {
+                    r.fold_value_into(&w, &mut acc, layout.stiffness());
                 }
                 acc.e.value
             }
             Threats::Spatial { layout, .. } => {
                 let mut acc = ExposureAcc::<3>::new();
                 layout.fold_value_into(p, &mut acc);
-                for (shape, half, active) in &self.spatial[range] {
-                    if *active && !shape.outside_box(p, half) {
-                        acc.fold_value(shape.f(p), layout.stiffness());
-                    }
+                for r in &self.spatial[range] {
+                    r.fold_value_into(p, &mut acc, layout.stiffness());
                 }
                 acc.e.value
             }

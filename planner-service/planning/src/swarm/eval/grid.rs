@@ -4,17 +4,10 @@
 use wingman_interfaces::{MAX_TARGETS, Model, Objective};
 
 use crate::dynamics::G0;
+use crate::estimation::{TabledRegion, tabulate};
 use crate::lead::LeadPath;
 use crate::problem::{Problem, Threats};
-use crate::threat::{ExposureAcc, Superquadric, ThreatLayout, cutoff_f};
-
-/// A moving threat's region at one sample time with its cut-off box.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct CachedRegion<const D: usize> {
-    shape: Superquadric<D>,
-    half: [f64; D],
-    active: bool,
-}
+use crate::threat::{ExposureAcc, ThreatLayout, cutoff_f};
 
 /// The static threats, held inline: one per grid, read at every sample (a box would add
 /// an indirection to the hot path for no saving).
@@ -102,8 +95,8 @@ pub(crate) struct Grid {
     layout: Layout,
     stiffness: f64,
     n_moving: usize,
-    moving2: Vec<CachedRegion<2>>,
-    moving3: Vec<CachedRegion<3>>,
+    moving2: Vec<TabledRegion<2>>,
+    moving3: Vec<TabledRegion<3>>,
 }
 
 impl Grid {
@@ -277,40 +270,21 @@ impl Grid {
         }
         self.moving2.clear();
         self.moving3.clear();
+        // The moving threats' regions at the sample times (`time(j)`).
+        let (t0, h) = (self.t0, self.h);
+        let times = (0..n).map(|j| t0 + j as f64 * h);
         match &problem.threats {
             Threats::Planar { layout, moving } => {
                 self.layout = Layout::Planar(*layout);
                 self.stiffness = layout.stiffness();
                 self.n_moving = moving.len();
-                let fc = cutoff_f(self.stiffness);
-                for j in 0..n {
-                    let t = self.time(j);
-                    for m in moving {
-                        let reg = m.region_at(t);
-                        self.moving2.push(CachedRegion {
-                            shape: reg.shape,
-                            half: reg.shape.cutoff_half_extents(fc, true),
-                            active: m.is_active(t),
-                        });
-                    }
-                }
+                tabulate(moving, times, cutoff_f(self.stiffness), &mut self.moving2);
             }
             Threats::Spatial { layout, moving } => {
                 self.layout = Layout::Spatial(*layout);
                 self.stiffness = layout.stiffness();
                 self.n_moving = moving.len();
-                let fc = cutoff_f(self.stiffness);
-                for j in 0..n {
-                    let t = self.time(j);
-                    for m in moving {
-                        let reg = m.region_at(t);
-                        self.moving3.push(CachedRegion {
-                            shape: reg.shape,
-                            half: reg.shape.cutoff_half_extents(fc, true),
-                            active: m.is_active(t),
-                        });
-                    }
-                }
+                tabulate(moving, times, cutoff_f(self.stiffness), &mut self.moving3);
             }
         }
     }
@@ -352,9 +326,7 @@ impl Grid {
                 let mut acc = ExposureAcc::<2>::new();
                 layout.fold_value_into(&w, &mut acc);
                 for c in &self.moving2[j * self.n_moving..(j + 1) * self.n_moving] {
-                    if c.active && !c.shape.outside_box(&w, &c.half) {
-                        acc.fold_value(c.shape.f(&w), s);
-                    }
+                    c.fold_value_into(&w, &mut acc, s);
                 }
                 acc.e.value
             }
@@ -362,9 +334,7 @@ impl Grid {
                 let mut acc = ExposureAcc::<3>::new();
                 layout.fold_value_into(p, &mut acc);
                 for c in &self.moving3[j * self.n_moving..(j + 1) * self.n_moving] {
-                    if c.active && !c.shape.outside_box(p, &c.half) {
-                        acc.fold_value(c.shape.f(p), s);
-                    }
+                    c.fold_value_into(p, &mut acc, s);
                 }
                 acc.e.value
             }
