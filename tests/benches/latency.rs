@@ -8,7 +8,8 @@
 //! ```
 //!
 //! Options (after `--`): `--quick`; `--budget-2d-ms N`, `--budget-3d-ms N` (the planner's
-//! budgets, default 500 / 2500 ms as in `planner.toml`); `--out FILE` (default
+//! re-plan budgets, which the pop-ups' re-plans run under; default `planner.toml`'s
+//! `replan_2d_ms` / `replan_3d_ms`; the take-off plan keeps `plan_2d_ms` / `plan_3d_ms`); `--out FILE` (default
 //! `docs/benchmarks/latency.json`); `--round-trip-only` (the small raw round trip and the
 //! service's, both conditions, ~1 min: an A/B of the message path); `--message-slice-us N`
 //! (the planner's `scheduling.message_slice_us`, default its own default).
@@ -142,8 +143,8 @@ fn main() {
     }
     let mut o = Options {
         quick: false,
-        budget_2d_ms: 500,
-        budget_3d_ms: 2500,
+        budget_2d_ms: wingman_ipc::ServiceConfig::default().budget.replan_2d_ms,
+        budget_3d_ms: wingman_ipc::ServiceConfig::default().budget.replan_3d_ms,
         out: Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/benchmarks/latency.json"),
         round_trip_only: false,
         message_slice_us: None,
@@ -470,8 +471,9 @@ fn report(
         "affinity": format!("taskset -c {CORES} (bench, echo, planner); hog: one busy-loop process per core"),
         "planner": {
             "config": format!(
-                "plan_2d_ms = {}, plan_3d_ms = {}, min_spacing_ms = {MIN_SPACING_MS}, \
-                 duty_cycle = 1.0, duty_window_ms = {DUTY_WINDOW_MS}, threads = {SOLVER_THREADS}",
+                "replan_2d_ms = {}, replan_3d_ms = {} (plan_2d_ms, plan_3d_ms: the defaults), \
+                 min_spacing_ms = {MIN_SPACING_MS}, duty_cycle = 1.0, \
+                 duty_window_ms = {DUTY_WINDOW_MS}, threads = {SOLVER_THREADS}",
                 o.budget_2d_ms, o.budget_3d_ms
             ),
             "scenarios": {"2d": "2d-min-time-avoidable", "3d": "3d-min-time-avoidable"},
@@ -661,7 +663,7 @@ fn planner_toml(dir: &Path, o: &Options) -> PathBuf {
     std::fs::write(
         &p,
         format!(
-            "[budget]\nplan_2d_ms = {0}\nplan_3d_ms = {1}\nreplan_2d_ms = {0}\nreplan_3d_ms = {1}\n\
+            "[budget]\nreplan_2d_ms = {0}\nreplan_3d_ms = {1}\n\
              min_spacing_ms = {MIN_SPACING_MS}\nduty_cycle = 1.0\nduty_window_ms = {DUTY_WINDOW_MS}\n\n\
              [solver]\nthreads = {SOLVER_THREADS}\n{2}",
             o.budget_2d_ms,

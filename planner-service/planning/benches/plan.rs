@@ -1,8 +1,10 @@
 //! Planner benchmark (issue 5): for every canonical scenario, the take-off plan with 20
 //! swarm seeds — median and p95 of the plan time, the share of swarm, NLP and the rest,
-//! the cost spread across seeds, peak heap — and how far past a too-short deadline the
-//! planner returns. Prints a Markdown table (run with `cargo bench -p wingman-planner
-//! --bench plan`; `-- --runs N`, `-- --only NAME` to narrow it, `-- --sequential`).
+//! the cost spread across seeds, peak heap — and, under budgets too short for the whole
+//! NLP stage (2-D 5, 20, 50 ms; 3-D 20, 50, 150 ms), the qualities and how far past its
+//! deadline the planner returns. Prints Markdown tables (run with `cargo bench -p
+//! wingman-planning --bench plan`; `-- --runs N`, `-- --only NAME` to narrow it,
+//! `-- --sequential`, `-- --short-only` for the short budgets alone).
 //!
 //! The peak heap is counted in a pass of its own (the same plans again), not in the
 //! timed runs: the counting allocator's shared counters, updated by both threads at
@@ -91,6 +93,7 @@ fn main() {
         .and_then(|i| args.get(i + 1))
         .cloned();
     let sequential = args.iter().any(|a| a == "--sequential");
+    let short_only = args.iter().any(|a| a == "--short-only");
     let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
     let settings = PlannerSettings::default();
     let scenarios: Vec<(&str, Problem)> = BUNDLED
@@ -108,139 +111,144 @@ fn main() {
     // The KKT workspaces pooled over the whole bench, as a service's planner pools them
     // over its plans.
     let kkt = Arc::new(KktCache::new());
-    // One take-off plan with a fresh planner and swarm seed `seed`.
-    let plan_once = |problem: &Problem, seed: u64| {
-        let s = settings_of(seed);
-        Planner::with_kkt_cache(&s, Arc::clone(&kkt))
-            .plan(problem, &s, Deadline::after(clock, Duration::from_secs(30)))
-            .unwrap()
-    };
-    let plan = |problem: &Problem, seed: u64, tally: &mut Tally| {
-        let out = plan_once(problem, seed);
-        let t = out.times.total.as_secs_f64() * 1e3;
-        tally.times.push(t);
-        tally.swarm += out.times.swarm.as_secs_f64() * 1e3;
-        tally.nlp += out.times.nlp.as_secs_f64() * 1e3;
-        tally.ranking += out.times.ranking.as_secs_f64() * 1e3;
-        tally.total += t;
-        tally.costs.push(out.cost);
-        *tally
-            .qualities
-            .entry(format!("{:?}", out.quality))
-            .or_insert(0) += 1;
-    };
-    // Interleaved (default): round `seed` plans every scenario once, so that each
-    // scenario's runs spread over the whole bench and a slow spell of the host weighs on
-    // all scenarios alike instead of on whichever ran through it. `--sequential`: each
-    // scenario's runs in a row (a stream of re-plans of one mission).
-    let mut tallies: Vec<Tally> = scenarios.iter().map(|_| Tally::default()).collect();
-    let mut host = Vec::new();
-    if sequential {
-        for ((_, problem), tally) in scenarios.iter().zip(&mut tallies) {
-            host.push(host_reference_ms());
-            for seed in 1..=runs {
-                plan(problem, seed, tally);
-            }
-        }
-    } else {
-        for seed in 1..=runs {
-            host.push(host_reference_ms());
-            for ((_, problem), tally) in scenarios.iter().zip(&mut tallies) {
-                plan(problem, seed, tally);
-            }
-        }
-    }
-    host.push(host_reference_ms());
-    // The peak heap of each scenario's plans, untimed, from an empty workspace pool (the
-    // pool keeps the workspaces it is given back, up to its budget: counted here).
-    let peaks: Vec<f64> = scenarios
-        .iter()
-        .map(|(_, problem)| {
-            kkt.clear_workspace_pool();
-            peak_of(|| {
-                for seed in 1..=runs {
-                    plan_once(problem, seed);
-                }
-            }) as f64
-                / (1024.0 * 1024.0)
-        })
-        .collect();
-    println!(
-        "| scenario | median ms | p95 ms | swarm % | NLP % | of it ranking % | rest % | cost min | cost max | spread % | peak heap MiB | quality |"
-    );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
-    for (((name, _), tally), peak) in scenarios.iter().zip(&mut tallies).zip(&peaks) {
-        tally.times.sort_by(f64::total_cmp);
-        tally.costs.sort_by(f64::total_cmp);
-        let (times, costs, total) = (&tally.times, &tally.costs, tally.total);
-        let (lo, hi) = (costs[0], costs[costs.len() - 1]);
-        println!(
-            "| {name} | {:.1} | {:.1} | {:.0} | {:.0} | {:.0} | {:.0} | {lo:.6} | {hi:.6} | {:.3} | {peak:.1} | {} |",
-            percentile(times, 0.5),
-            percentile(times, 0.95),
-            100.0 * tally.swarm / total,
-            100.0 * tally.nlp / total,
-            100.0 * tally.ranking / total,
-            100.0 * (total - tally.swarm - tally.nlp) / total,
-            100.0 * (hi - lo) / lo.abs().max(1e-12),
-            tally
+    if !short_only {
+        // One take-off plan with a fresh planner and swarm seed `seed`.
+        let plan_once = |problem: &Problem, seed: u64| {
+            let s = settings_of(seed);
+            Planner::with_kkt_cache(&s, Arc::clone(&kkt))
+                .plan(problem, &s, Deadline::after(clock, Duration::from_secs(30)))
+                .unwrap()
+        };
+        let plan = |problem: &Problem, seed: u64, tally: &mut Tally| {
+            let out = plan_once(problem, seed);
+            let t = out.times.total.as_secs_f64() * 1e3;
+            tally.times.push(t);
+            tally.swarm += out.times.swarm.as_secs_f64() * 1e3;
+            tally.nlp += out.times.nlp.as_secs_f64() * 1e3;
+            tally.ranking += out.times.ranking.as_secs_f64() * 1e3;
+            tally.total += t;
+            tally.costs.push(out.cost);
+            *tally
                 .qualities
-                .iter()
-                .map(|(q, n)| format!("{q} {n}"))
-                .collect::<Vec<_>>()
-                .join(", "),
+                .entry(format!("{:?}", out.quality))
+                .or_insert(0) += 1;
+        };
+        // Interleaved (default): round `seed` plans every scenario once, so that each
+        // scenario's runs spread over the whole bench and a slow spell of the host weighs on
+        // all scenarios alike instead of on whichever ran through it. `--sequential`: each
+        // scenario's runs in a row (a stream of re-plans of one mission).
+        let mut tallies: Vec<Tally> = scenarios.iter().map(|_| Tally::default()).collect();
+        let mut host = Vec::new();
+        if sequential {
+            for ((_, problem), tally) in scenarios.iter().zip(&mut tallies) {
+                host.push(host_reference_ms());
+                for seed in 1..=runs {
+                    plan(problem, seed, tally);
+                }
+            }
+        } else {
+            for seed in 1..=runs {
+                host.push(host_reference_ms());
+                for ((_, problem), tally) in scenarios.iter().zip(&mut tallies) {
+                    plan(problem, seed, tally);
+                }
+            }
+        }
+        host.push(host_reference_ms());
+        // The peak heap of each scenario's plans, untimed, from an empty workspace pool (the
+        // pool keeps the workspaces it is given back, up to its budget: counted here).
+        let peaks: Vec<f64> = scenarios
+            .iter()
+            .map(|(_, problem)| {
+                kkt.clear_workspace_pool();
+                peak_of(|| {
+                    for seed in 1..=runs {
+                        plan_once(problem, seed);
+                    }
+                }) as f64
+                    / (1024.0 * 1024.0)
+            })
+            .collect();
+        println!(
+            "| scenario | median ms | p95 ms | swarm % | NLP % | of it ranking % | rest % | cost min | cost max | spread % | peak heap MiB | quality |"
+        );
+        println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+        for (((name, _), tally), peak) in scenarios.iter().zip(&mut tallies).zip(&peaks) {
+            tally.times.sort_by(f64::total_cmp);
+            tally.costs.sort_by(f64::total_cmp);
+            let (times, costs, total) = (&tally.times, &tally.costs, tally.total);
+            let (lo, hi) = (costs[0], costs[costs.len() - 1]);
+            println!(
+                "| {name} | {:.1} | {:.1} | {:.0} | {:.0} | {:.0} | {:.0} | {lo:.6} | {hi:.6} | {:.3} | {peak:.1} | {} |",
+                percentile(times, 0.5),
+                percentile(times, 0.95),
+                100.0 * tally.swarm / total,
+                100.0 * tally.nlp / total,
+                100.0 * tally.ranking / total,
+                100.0 * (total - tally.swarm - tally.nlp) / total,
+                100.0 * (hi - lo) / lo.abs().max(1e-12),
+                tally
+                    .qualities
+                    .iter()
+                    .map(|(q, n)| format!("{q} {n}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            );
+        }
+        let order = if sequential {
+            "before each scenario's runs and at the end"
+        } else {
+            "before each round of all scenarios and at the end"
+        };
+        let text: Vec<String> = host.iter().map(|h| format!("{h:.1}")).collect();
+        host.sort_by(f64::total_cmp);
+        println!(
+            "\nhost ref ms ({order}): {} (min {:.1}, median {:.1}, max {:.1}); {} solves took their KKT workspace from the pool",
+            text.join(" "),
+            host[0],
+            percentile(&host, 0.5),
+            host[host.len() - 1],
+            kkt.workspace_reuses(),
         );
     }
-    let order = if sequential {
-        "before each scenario's runs and at the end"
-    } else {
-        "before each round of all scenarios and at the end"
-    };
-    let text: Vec<String> = host.iter().map(|h| format!("{h:.1}")).collect();
-    host.sort_by(f64::total_cmp);
-    println!(
-        "\nhost ref ms ({order}): {} (min {:.1}, median {:.1}, max {:.1}); {} solves took their KKT workspace from the pool",
-        text.join(" "),
-        host[0],
-        percentile(&host, 0.5),
-        host[host.len() - 1],
-        kkt.workspace_reuses(),
-    );
-    // Deadline overshoot: a budget far too short for the NLP.
-    println!("\n| scenario | budget ms | returned after ms (median / max of {runs}) | quality |");
+    // Short budgets: the quality a budget too short for the whole NLP stage gives (the
+    // floor, `Feasible`, or the swarm's path), and how far past its deadline the planner
+    // returns.
+    println!("\n| scenario | budget ms | returned after ms (median / max of {runs}) | qualities |");
     println!("|---|---:|---:|---|");
-    for name in ["2d-min-time-avoidable", "3d-min-time-rendezvous-avoidable"] {
-        if only.as_ref().is_some_and(|o| !name.contains(o.as_str())) {
-            continue;
-        }
-        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
-        for budget_ms in [5u64, 20, 50] {
+    for (name, problem) in &scenarios {
+        let budgets: &[u64] = if problem.dim() == 3 {
+            &[20, 50, 150]
+        } else {
+            &[5, 20, 50]
+        };
+        for &budget_ms in budgets {
             let mut over = Vec::new();
-            let mut quality = String::new();
-            // One planner across the runs, as the service keeps one: its estimate of the
-            // NLP's set-up time carries over from plan to plan.
-            let mut planner = Planner::new(&settings);
+            let mut qualities = std::collections::BTreeMap::<String, usize>::new();
+            // One planner across the runs, as the service keeps one: its estimates of the
+            // NLP's timing carry over from plan to plan.
+            let mut planner = Planner::with_kkt_cache(&settings, Arc::clone(&kkt));
             for seed in 1..=runs {
-                let s = PlannerSettings {
-                    swarm: settings.swarm.clone().with_seed(seed),
-                    ..settings.clone()
-                };
+                let s = settings_of(seed);
                 let began = clock.now();
                 let out = planner
                     .plan(
-                        &problem,
+                        problem,
                         &s,
                         Deadline::after(clock, Duration::from_millis(budget_ms)),
                     )
                     .unwrap();
                 over.push((clock.now() - began).as_secs_f64() * 1e3);
-                quality = format!("{:?}", out.quality);
+                *qualities.entry(format!("{:?}", out.quality)).or_insert(0) += 1;
             }
             over.sort_by(f64::total_cmp);
+            let qualities: Vec<String> =
+                qualities.iter().map(|(q, n)| format!("{q} {n}")).collect();
             println!(
-                "| {name} | {budget_ms} | {:.1} / {:.1} | {quality} (last) |",
+                "| {name} | {budget_ms} | {:.1} / {:.1} | {} |",
                 percentile(&over, 0.5),
-                over[over.len() - 1]
+                over[over.len() - 1],
+                qualities.join(", ")
             );
         }
     }

@@ -226,11 +226,12 @@ impl Planner {
                 PlanOutcome::of_warm(warm)
             }
             Some(warm) => {
-                let mut outcome = self.global(problem, settings, deadline)?;
+                // A warm plan is a better floor than the coarse one.
+                let mut outcome = self.global(problem, settings, deadline, !warm.has_plan())?;
                 outcome.offer(warm);
                 outcome
             }
-            None => self.global(problem, settings, deadline)?,
+            None => self.global(problem, settings, deadline, true)?,
         };
         outcome.times.total = clock.now().saturating_sub(started);
         Ok(outcome)
@@ -249,12 +250,14 @@ impl Planner {
     }
 
     /// The global search: seeds and swarm, the NLP stage over distinct starts, the
-    /// refinement of the winner.
+    /// refinement of the winner; with `floor_wanted`, under a budget that may not hold the
+    /// stage, first the floor (`nlp_stage::floor`).
     fn global(
         &mut self,
         problem: &Problem,
         settings: &PlannerSettings,
         deadline: Deadline<'static>,
+        floor_wanted: bool,
     ) -> Result<PlanOutcome, PlanError> {
         let clock = deadline.clock();
         let started = clock.now();
@@ -262,7 +265,7 @@ impl Planner {
         let model = usize::from(problem.dim() == 3);
         let (timing, stage_timing) = (self.timing[model], self.stage[model]);
 
-        let swarm_deadline = swarm_deadline(settings, deadline, timing, stage_timing);
+        let swarm_deadline = swarm_deadline(settings, deadline, timing, stage_timing, floor_wanted);
         let sw: SwarmOutcome =
             swarm::run(problem, &settings.swarm, &mut self.swarm, swarm_deadline)?;
         times.swarm = sw.elapsed;
@@ -279,6 +282,19 @@ impl Planner {
         let deadline = deadline.earlier(fallback_cost * 2);
 
         let nlp_started = clock.now();
+        // A budget that may not hold the stage (its ranking and a solve in a third of what
+        // is left, as recent plans took them: a stage that yields needs the finals and a
+        // round after its ranking, and the ranking's estimate decays while no plan tries
+        // it): first the floor, one coarse solve of the swarm's path, kept if the stage
+        // yields nothing.
+        let short = !stage_timing.fits_the_stage(&timing, deadline.remaining() / 3);
+        let floor = if floor_wanted && short && timing.fits_a_solve(deadline.remaining()) {
+            Some(nlp_stage::floor(
+                problem, settings, &sw.best, deadline, timing, &self.kkt,
+            ))
+        } else {
+            None
+        };
         // No time left for the ranking and one solve's set-up and wrap-up after it (as
         // recent plans measured them): no NLP stage at all, not even its starts (2-3 ms of
         // dense costs). (An expired deadline is one of these.) Asked again now: a swarm
@@ -311,11 +327,28 @@ impl Planner {
         };
         times.ranking = done.ranked_at.saturating_sub(nlp_started);
         let Gathered {
-            report,
+            mut report,
             accepted,
             cut,
             first_optimal,
         } = gather(&stage, done, deadline)?;
+        let stage_yields = accepted.is_some();
+        let (accepted, quality_of_floor) = match (accepted, floor) {
+            (Some(a), _) => (Some(a), None),
+            (None, Some((result, mesh))) => {
+                let (solved, iterations, status, seen) = result?;
+                stage.seen.record(seen);
+                report.iterations.push(iterations);
+                report.status = Some(status);
+                let floor = solved.map(|s| (s, mesh));
+                if let Some((s, mesh)) = &floor {
+                    report.objective = s.objective;
+                    report.intervals = mesh.phases.iter().map(Vec::len).collect();
+                }
+                (floor, Some(Quality::Feasible))
+            }
+            (None, None) => (None, None),
+        };
         times.nlp = clock.now().saturating_sub(nlp_started);
 
         // What this plan teaches about the next ones' timing. The stage ran out of time
@@ -324,7 +357,7 @@ impl Planner {
         self.timing[model] = self.timing[model].after(stage.seen.get());
         let ranking = if no_time {
             Ranking::Skipped
-        } else if accepted.is_none() && (cut || deadline.expired()) {
+        } else if !stage_yields && (cut || deadline.expired()) {
             Ranking::Cut(times.nlp)
         } else {
             Ranking::Done(times.ranking)
@@ -336,7 +369,7 @@ impl Planner {
             Some((a, _)) => {
                 let mut flown = Trajectory::default();
                 export(&a.tr, &a.x, &settings.export, &mut flown);
-                (a.quality, flown)
+                (quality_of_floor.unwrap_or(a.quality), flown)
             }
             None => (Quality::SwarmOnly, fallback),
         };
@@ -391,16 +424,27 @@ fn reference_export(settings: &PlannerSettings) -> ExportSettings {
 
 /// The swarm's deadline. The NLP stage runs only when the budget left after the swarm's
 /// share (and the fallback's reserve) can hold it, as recent plans took it: it yields
-/// nothing before its ranking is done. Otherwise the swarm has all of the budget but the
-/// reserve (twice the fallback's cost, at most half the budget).
+/// nothing before its ranking is done. With `floor_wanted`, a budget that holds the floor
+/// (one solve) gives the swarm half its share and the floor the rest (with the full share
+/// the floor's solve was cut unfinished on 1 in 10 plans of the unavoidable 2-D missions
+/// at 50 ms). Otherwise the swarm has all of the budget but
+/// the reserve (twice the fallback's cost, at most half the budget).
 fn swarm_deadline(
     settings: &PlannerSettings,
     deadline: Deadline<'static>,
     timing: SolveTiming,
     stage_timing: StageTiming,
+    floor_wanted: bool,
 ) -> Deadline<'static> {
+    let share = settings.swarm_share.clamp(0.0, 1.0);
+    let after_share = deadline
+        .remaining()
+        .mul_f64(1.0 - share)
+        .saturating_sub(fallback_reserve(deadline, stage_timing));
     if nlp_possible(settings, deadline, timing, stage_timing) {
-        deadline.share(settings.swarm_share.clamp(0.0, 1.0))
+        deadline.share(share)
+    } else if floor_wanted && timing.fits_a_solve(after_share) {
+        deadline.share(share / 2.0)
     } else {
         deadline.earlier(fallback_reserve(deadline, stage_timing))
     }

@@ -137,6 +137,47 @@ pub(super) fn solve_on_mesh(
     Ok((solved, out.iterations, out.status, seen))
 }
 
+/// The floor of a budget that may not hold the NLP stage: one solve of the swarm's best
+/// (`swarm_path`, lifted; the fallback flown with the tracking law was a worse start: a 3-D
+/// rendezvous floor did not converge from it) on its coarse ranking mesh at the finalists' settings (their tight constraint
+/// tolerance), accepted only as feasible as a refined solve must be. A plan from it is `Feasible` (a coarse mesh's solution, neither
+/// refined nor compared with other basins); it is kept when the stage yields nothing.
+pub(super) fn floor(
+    problem: &Problem,
+    settings: &PlannerSettings,
+    swarm_path: &Trajectory,
+    deadline: Deadline<'static>,
+    timing: SolveTiming,
+    kkt: &Arc<KktCache>,
+) -> (MeshSolveResult, Mesh) {
+    let mesh = super::ranking_meshes(problem, settings, std::slice::from_ref(swarm_path))
+        .pop()
+        .unwrap_or_else(|| unreachable!("one mesh per start"));
+    let job = MeshSolve {
+        problem,
+        mesh: &mesh,
+        guess: swarm_path,
+        settings,
+        nlp_settings: &settings.finalist_nlp,
+        refined: false,
+        feasibility_tol: settings.nlp.feasibility_tol,
+        warm_from: None,
+        mu_init: ranking_mu_init(problem, settings),
+        start_x: None,
+        cancel: None,
+    };
+    (solve_on_mesh(job, deadline, timing, kkt), mesh)
+}
+
+/// The first barrier parameter of a ranking solve (`None`: the ranking settings').
+fn ranking_mu_init(problem: &Problem, settings: &PlannerSettings) -> Option<f64> {
+    if problem.dim() == 3 {
+        settings.ranking_mu_init_3d
+    } else {
+        None
+    }
+}
+
 /// A mesh solve's accepted result (if any), iterations, status and timing.
 pub(super) type MeshSolveResult =
     Result<(Option<Solved>, usize, NlpStatus, SolveTiming), PlanError>;
@@ -266,11 +307,7 @@ impl schedule::Stage for NlpStage<'_> {
             refined: false,
             feasibility_tol: settings.ranking_feasibility_tol,
             warm_from: None,
-            mu_init: if problem.dim() == 3 {
-                settings.ranking_mu_init_3d
-            } else {
-                None
-            },
+            mu_init: ranking_mu_init(problem, settings),
             start_x: None,
             cancel: None,
         });
