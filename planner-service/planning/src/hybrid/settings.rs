@@ -68,6 +68,11 @@ pub struct PlannerSettings {
     /// Start the solves on the working and the refined meshes primal-dual from the
     /// previous mesh's solution (multipliers carried over, see `collocation::warm`).
     pub warm_mesh_changes: bool,
+    /// The starts from the global search's seeds (of distinct basins) that a warm re-plan
+    /// adds when a new threat lies across the plan in flight (2-D).
+    pub warm_seed_starts: usize,
+    /// The same in 3-D.
+    pub warm_seed_starts_3d: usize,
     /// Split a finalist's working-mesh intervals where its ranked path crosses a threat's
     /// edge (the exposure along an interval varying by more than this; phases before the
     /// last; see [`split_crossings`]); `None`: no split.
@@ -129,6 +134,10 @@ impl Default for PlannerSettings {
             finalist_gap_tol: 0.1,
             warm_mesh_changes: true, // 9-28 -> 3-11 iterations per mesh change (0006)
             crossing_split: Some(0.3), // a crossing steps the exposure by ~1 (0029)
+            // 2-D pop-ups at 50 ms: 9-10 -> 16-17 of 18 within 0.5 %; 3-D ranking them
+            // took the warm path past 150 ms (0035).
+            warm_seed_starts: 3,
+            warm_seed_starts_3d: 0,
         }
     }
 }
@@ -182,6 +191,14 @@ impl PlannerSettings {
         }
         if self.refine_rounds > 16 {
             return out("refine_rounds", "must be at most 16");
+        }
+        for (setting, value) in [
+            ("warm_seed_starts", self.warm_seed_starts),
+            ("warm_seed_starts_3d", self.warm_seed_starts_3d),
+        ] {
+            if value > 16 {
+                return out(setting, "must be at most 16");
+            }
         }
         for (setting, value) in [
             ("ranking_feasibility_tol", self.ranking_feasibility_tol),

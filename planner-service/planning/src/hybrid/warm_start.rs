@@ -15,10 +15,13 @@ use super::{
     Gathered, NlpReport, PlanError, PlanOutcome, PlanPath, Planner, PlannerSettings, StageTimes,
     gather, ranking_meshes, reference_export, schedule, trajectory_cost,
 };
+use crate::basins;
 use crate::clock::Deadline;
 use crate::collocation::export;
 use crate::collocation::transcription::nearest_turn;
 use crate::problem::{Problem, Threats};
+use crate::seeding;
+use crate::swarm::SwarmError;
 use crate::trajectory::Trajectory;
 
 /// What a re-plan's warm path did.
@@ -62,7 +65,11 @@ impl Planner {
         let starts: Vec<Trajectory> = if bends.is_empty() {
             Vec::new()
         } else {
-            std::iter::once(guess.clone()).chain(bends).collect()
+            let seeds = seed_starts(problem, settings, &guess, deadline)?;
+            std::iter::once(guess.clone())
+                .chain(bends)
+                .chain(seeds)
+                .collect()
         };
         let coarse = ranking_meshes(problem, settings, &starts);
         // The export of its plan is kept time for, as the global search keeps it.
@@ -112,6 +119,37 @@ impl Planner {
             trajectory,
         })
     }
+}
+
+/// The starts from the global search's seeds that a warm path with bends adds (2-D:
+/// `warm_seed_starts`, 3-D: `warm_seed_starts_3d`): the cheapest seeds of the re-plan's
+/// problem that pass some threat on another side than `guess` and than each other
+/// (`basins::candidates`). A pop-up across the plan often makes the best route another
+/// way around other threats too, which a bend around the pop-up alone does not reach.
+fn seed_starts(
+    problem: &Problem,
+    settings: &PlannerSettings,
+    guess: &Trajectory,
+    deadline: Deadline<'static>,
+) -> Result<Vec<Trajectory>, PlanError> {
+    let count = if problem.dim() == 3 {
+        settings.warm_seed_starts_3d
+    } else {
+        settings.warm_seed_starts
+    };
+    if count == 0 {
+        return Ok(Vec::new());
+    }
+    let mut seeds = Vec::new();
+    seeding::seeds_until(problem, &settings.swarm.seeds, &mut seeds, &|| {
+        deadline.expired()
+    })
+    .map_err(SwarmError::from)?;
+    let cost = |tr: &Trajectory| trajectory_cost(problem, tr);
+    let mut starts = basins::candidates(problem, guess, &seeds, 1 + count, settings.threads, cost);
+    // The first is `guess` itself.
+    starts.remove(0);
+    Ok(starts)
 }
 
 impl WarmPlan {
