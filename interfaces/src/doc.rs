@@ -73,6 +73,7 @@ pub fn interfaces_markdown() -> String {
         ("MAX_ROUTE_POINTS", MAX_ROUTE_POINTS),
         ("MAX_ROAD_POINTS", MAX_ROAD_POINTS),
         ("MAX_PLAN_SAMPLES", MAX_PLAN_SAMPLES),
+        ("MAX_PLAN_CUTS", MAX_PLAN_CUTS),
         ("STATE_DIM", STATE_DIM),
         ("CONTROL_DIM", CONTROL_DIM),
         ("THREAT_NAME_LEN", THREAT_NAME_LEN),
@@ -119,12 +120,14 @@ pub fn interfaces_markdown() -> String {
     wire_table::<VehicleLimits>(&mut out);
     wire_table::<Weights>(&mut out);
     wire_table::<PlanSample>(&mut out);
+    wire_table::<PlanCut>(&mut out);
     out.push_str("## Enums\n\n");
     enum_table::<Model>(&mut out);
     enum_table::<Objective>(&mut out);
     enum_table::<ThreatKind>(&mut out);
     enum_table::<Trigger>(&mut out);
     enum_table::<Quality>(&mut out);
+    enum_table::<PlanPath>(&mut out);
     enum_table::<PlannerState>(&mut out);
     out
 }

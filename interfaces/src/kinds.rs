@@ -97,6 +97,16 @@ wire_enum! {
 }
 
 wire_enum! {
+    /// Which path of the planner made a plan.
+    pub enum PlanPath {
+        /// The global search: seeds, swarm, ranked starts, finalists, refinement.
+        Global = 0,
+        /// A re-plan's warm path: the plan in flight, cut at the new start and solved again.
+        Warm = 1,
+    }
+}
+
+wire_enum! {
     /// What the planner is doing.
     pub enum PlannerState {
         /// Waiting for a trigger.

@@ -30,12 +30,12 @@ mod validate;
 
 pub use doc::interfaces_markdown;
 pub use header::Header;
-pub use kinds::{Model, Objective, PlannerState, Quality, ThreatKind, Trigger};
+pub use kinds::{Model, Objective, PlanPath, PlannerState, Quality, ThreatKind, Trigger};
 pub use layout::{Wire, WrongLength};
 pub use lead::{LeadRoute, LeadState};
 pub use message::Message;
 pub use ownship::{OWNSHIP_HOLDING, OwnshipState};
-pub use plan::{Plan, PlanSample};
+pub use plan::{Plan, PlanCut, PlanSample};
 pub use service::{Service, VehicleIdError, service_name, validate_vehicle_id};
 pub use status::{PlannerStatus, STALE_LEAD, STALE_OWNSHIP, STALE_TASKING, STALE_TRACKS};
 pub use tasking::{Tasking, VehicleLimits, Weights};
@@ -48,7 +48,7 @@ pub use validate::{Checked, ValidationError};
 pub use iceoryx2::prelude::ZeroCopySend;
 
 /// Version of this contract. A message carrying another version is rejected.
-pub const PROTOCOL_VERSION: u32 = 1;
+pub const PROTOCOL_VERSION: u32 = 2;
 
 /// Intermediate targets in one tasking.
 pub const MAX_TARGETS: usize = 8;
@@ -60,6 +60,9 @@ pub const MAX_ROUTE_POINTS: usize = 16;
 pub const MAX_ROAD_POINTS: usize = 16;
 /// Samples of a plan's trajectory.
 pub const MAX_PLAN_SAMPLES: usize = 2048;
+
+/// Deadline cuts carried in one plan (a plan has a few dozen places the deadline can cut).
+pub const MAX_PLAN_CUTS: usize = 64;
 /// Length of the state vectors (the 3-D model's 7 states; 2-D uses the first 3).
 pub const STATE_DIM: usize = 7;
 /// Length of the control vectors (the 3-D model's 2 controls; 2-D uses the first).

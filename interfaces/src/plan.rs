@@ -1,8 +1,8 @@
 use crate::message::{Message, validate_common};
 use crate::validate::{self, Checked, ValidationError};
 use crate::{
-    CONTROL_DIM, Header, MAX_PHASES, MAX_PLAN_SAMPLES, Model, Quality, STATE_DIM, Service, Trigger,
-    wire_struct,
+    CONTROL_DIM, Header, MAX_PHASES, MAX_PLAN_CUTS, MAX_PLAN_SAMPLES, Model, PlanPath, Quality,
+    STATE_DIM, Service, Trigger, wire_struct,
 };
 
 wire_struct! {
@@ -15,6 +15,21 @@ wire_struct! {
         pub state: [f64; STATE_DIM] ["m, rad, g"],
         /// Control (model order, zero-padded).
         pub control: [f64; CONTROL_DIM] ["rad/s, 1/s"],
+    }
+}
+
+wire_struct! {
+    /// A place where the plan's compute deadline changed the course of its computation: a
+    /// solve stopped after so many iterations, the swarm after so many rounds, a start not
+    /// solved, a path not run. Opaque to clients (`site` names the planner's work, `step`
+    /// how far it got); a replay feeds a plan's cuts back to the planner so that it takes
+    /// the same course (docs/ARCHITECTURE.md, "Deadline cuts").
+    #[type_name("wingman::PlanCut")]
+    pub struct PlanCut {
+        /// The work that was cut.
+        pub site: u32 ["code"],
+        /// How far it got when it was cut.
+        pub step: u32 ["-"],
     }
 }
 
@@ -40,6 +55,11 @@ wire_struct! {
         pub sample_count: u32 ["-"],
         /// 1 if `next_replan_s` holds a scheduled re-plan time, else 0.
         pub has_next_replan: u32 ["bool"],
+        /// `PlanPath` value: the path whose plan this is.
+        pub path: u32 ["enum"],
+        /// Number of valid entries in `cuts` (0: the deadline cut nothing; the plan is what
+        /// its inputs and seed make on any machine).
+        pub cut_count: u32 ["-"],
         /// Mission time of the trigger that caused the plan.
         pub created_at_s: f64 ["s"],
         /// Commit time: the tracker switches to this plan here (first sample's time).
@@ -57,6 +77,8 @@ wire_struct! {
         /// Mission time at which each phase ends (phase g ends on target g; the last on the
         /// final point or the rendezvous).
         pub phase_end_s: [f64; MAX_PHASES] ["s"],
+        /// Where the deadline cut the computation, sorted; `cut_count` valid.
+        pub cuts: [PlanCut; MAX_PLAN_CUTS] ["-"],
         /// Trajectory samples in increasing time; `sample_count` valid.
         pub samples: [PlanSample; MAX_PLAN_SAMPLES] ["-"],
     }
@@ -76,6 +98,16 @@ impl Plan {
     /// The vehicle model, if the field holds a known value.
     pub fn model(&self) -> Option<Model> {
         Model::from_wire(self.model)
+    }
+
+    /// The path, if the field holds a known value.
+    pub fn path(&self) -> Option<PlanPath> {
+        PlanPath::from_wire(self.path)
+    }
+
+    /// The valid deadline cuts (empty if the count is over capacity).
+    pub fn cuts(&self) -> &[PlanCut] {
+        self.cuts.get(..self.cut_count as usize).unwrap_or(&[])
     }
 
     /// The valid samples (empty if the count is over capacity).
@@ -110,6 +142,8 @@ impl Message for Plan {
         validate::enum_value("trigger", self.trigger, Trigger::from_wire)?;
         validate::enum_value("quality", self.quality, Quality::from_wire)?;
         validate::enum_value("model", self.model, Model::from_wire)?;
+        validate::enum_value("path", self.path, PlanPath::from_wire)?;
+        validate::count("cut_count", self.cut_count, 0, MAX_PLAN_CUTS)?;
         let phases = validate::count("phase_count", self.phase_count, 1, MAX_PHASES)?;
         let n = validate::count("sample_count", self.sample_count, 2, MAX_PLAN_SAMPLES)?;
         if self.has_next_replan > 1 {

@@ -171,8 +171,9 @@ fn track_and_ownship_layouts() {
 #[test]
 fn plan_layout() {
     pin::<PlanSample>(80, 8, &[("t_s", 0), ("state", 8), ("control", 64)]);
+    pin::<PlanCut>(8, 4, &[("site", 0), ("step", 4)]);
     pin::<Plan>(
-        184 + 80 * MAX_PLAN_SAMPLES,
+        704 + 80 * MAX_PLAN_SAMPLES,
         8,
         &[
             ("header", 0),
@@ -183,15 +184,18 @@ fn plan_layout() {
             ("phase_count", 44),
             ("sample_count", 48),
             ("has_next_replan", 52),
-            ("created_at_s", 56),
-            ("start_time_s", 64),
-            ("valid_until_s", 72),
-            ("cost", 80),
-            ("final_time_s", 88),
-            ("compute_ms", 96),
-            ("next_replan_s", 104),
-            ("phase_end_s", 112),
-            ("samples", 184),
+            ("path", 56),
+            ("cut_count", 60),
+            ("created_at_s", 64),
+            ("start_time_s", 72),
+            ("valid_until_s", 80),
+            ("cost", 88),
+            ("final_time_s", 96),
+            ("compute_ms", 104),
+            ("next_replan_s", 112),
+            ("phase_end_s", 120),
+            ("cuts", 192),
+            ("samples", 704),
         ],
     );
     const { assert!(MAX_PLAN_SAMPLES >= 512) };

@@ -312,6 +312,25 @@ fn plan_is_checked() {
         },
     );
     let mut m = common::plan();
+    m.path = 2;
+    rejects(
+        &m,
+        ValidationError::UnknownEnum {
+            field: "path",
+            value: 2,
+        },
+    );
+    let mut m = common::plan();
+    m.cut_count = MAX_PLAN_CUTS as u32 + 1;
+    rejects(
+        &m,
+        ValidationError::CountOverCapacity {
+            field: "cut_count",
+            count: MAX_PLAN_CUTS as u32 + 1,
+            capacity: MAX_PLAN_CUTS as u32,
+        },
+    );
+    let mut m = common::plan();
     m.samples[2].t_s = 200.0; // before samples[1]
     rejects(&m, ValidationError::TimeBackwards { field: "samples" });
     let mut m = common::plan();

@@ -11,6 +11,7 @@ use clap::{Parser, Subcommand};
 use wingman_planner::offline::{PlanRequest, plan_scenario, summary};
 use wingman_planner::service::{RunOptions, ServiceConfig, Shutdown};
 use wingman_planning::clock::MonotonicClock;
+use wingman_planning::cuts::ReplayCuts;
 use wingman_planning::scenario::load_by_path_or_name;
 
 /// Onboard route planner of the loyal wingman.
@@ -62,6 +63,11 @@ enum Command {
         /// Prints the effective configuration as TOML and exits.
         #[arg(long)]
         print_config: bool,
+        /// Replay: plan with no compute deadline, taking instead the deadline cuts logged
+        /// with a flight's plans (written by `wingman-harness replay`; see
+        /// docs/ARCHITECTURE.md, "Deadline cuts"). Not for flight.
+        #[arg(long, value_name = "FILE")]
+        replay_cuts: Option<PathBuf>,
     },
 }
 
@@ -72,7 +78,8 @@ fn main() -> ExitCode {
             config,
             vehicle,
             print_config,
-        } => serve(config, vehicle, print_config),
+            replay_cuts,
+        } => serve(config, vehicle, print_config, replay_cuts),
         Command::Plan {
             scenario,
             seed,
@@ -120,7 +127,12 @@ fn main() -> ExitCode {
 }
 
 /// `serve`: configuration, clock, signals, then `service::run`.
-fn serve(config: Option<PathBuf>, vehicle: Option<String>, print_config: bool) -> ExitCode {
+fn serve(
+    config: Option<PathBuf>,
+    vehicle: Option<String>,
+    print_config: bool,
+    replay_cuts: Option<PathBuf>,
+) -> ExitCode {
     let mut cfg = match &config {
         Some(path) => match ServiceConfig::load(path) {
             Ok(c) => c,
@@ -142,6 +154,13 @@ fn serve(config: Option<PathBuf>, vehicle: Option<String>, print_config: bool) -
         print!("{}", cfg.to_toml());
         return ExitCode::SUCCESS;
     }
+    let replay_cuts = match replay_cuts.as_deref().map(read_replay_cuts).transpose() {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
     // iceoryx2 logs through its own console logger: errors only unless IOX2_LOG_LEVEL
     // says otherwise (its "no config file, defaults used" warning is expected here).
     iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
@@ -152,6 +171,7 @@ fn serve(config: Option<PathBuf>, vehicle: Option<String>, print_config: bool) -
         clock,
         handle_signals: true,
         shutdown: Shutdown::new(),
+        replay_cuts,
     };
     match wingman_planner::service::run(options) {
         Ok(summary) => {
@@ -170,4 +190,10 @@ fn serve(config: Option<PathBuf>, vehicle: Option<String>, print_config: bool) -
             ExitCode::from(1)
         }
     }
+}
+
+/// The deadline cuts of `--replay-cuts FILE`.
+fn read_replay_cuts(path: &std::path::Path) -> Result<ReplayCuts, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    ReplayCuts::parse(&text).map_err(|e| format!("{}: {e}", path.display()))
 }

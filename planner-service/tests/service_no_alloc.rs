@@ -79,6 +79,7 @@ fn a_pass_of_the_message_loop_does_not_allocate() {
         clock,
         handle_signals: false,
         shutdown: Shutdown::new(),
+        replay_cuts: None,
     };
     // A subscriber as in the service (its formatter allocates for every line it writes):
     // at `warn`, a steady pass writes none.

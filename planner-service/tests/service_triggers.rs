@@ -340,6 +340,7 @@ fn a_plan_message_is_written_in_place_and_validates() {
         trigger: Trigger::PopUp,
         quality: Quality::Feasible,
         model: Model::TwoD,
+        path: wingman_interfaces::PlanPath::Global,
         created_at_s: -0.2,
         cost: 12.5,
         compute_ms: 140.0,

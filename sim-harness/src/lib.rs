@@ -94,8 +94,17 @@ pub fn summary(r: &report::Report, out: &std::path::Path, pngs: &[String]) -> St
     );
     for p in &r.plans {
         s.push_str(&format!(
-            "  plan {:>2} at {:7.1} s  {:<16} {:<9} compute {:6.0} ms  cost {:10.4}  starts {:7.1} s\n",
-            p.plan_id, p.at_s, p.trigger, p.quality, p.compute_ms, p.cost, p.start_s
+            "  plan {:>2} at {:7.1} s  {:<16} {:<9} {:<6} compute {:6.0} ms  cuts {:>2}  cost {:10.4}  \
+             starts {:7.1} s\n",
+            p.plan_id,
+            p.at_s,
+            p.trigger,
+            p.quality,
+            p.path,
+            p.compute_ms,
+            p.cuts,
+            p.cost,
+            p.start_s
         ));
     }
     s.push_str(&format!(

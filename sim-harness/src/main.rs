@@ -75,8 +75,8 @@ struct FlyArgs {
     /// Vehicle id (default: a fresh one per run with `spawn`, `w1` with `external`).
     #[arg(long)]
     vehicle: Option<String>,
-    /// Planner configuration for a spawned planner (default: the harness's, with budgets
-    /// that let today's planner converge; written to <out>/planner.toml).
+    /// Planner configuration for a spawned planner (default: the deployment defaults of
+    /// planner.toml, heartbeat 200 ms; written to <out>/planner.toml).
     #[arg(long, value_name = "FILE")]
     planner_config: Option<PathBuf>,
     /// End the flight at this mission time if the plan has not ended, s.

@@ -148,21 +148,15 @@ impl FlyOptions {
     }
 }
 
-/// The planner configuration the harness flies with: the defaults, with budgets that let
-/// today's planner converge (2 s per 2-D plan, 6 s per 3-D plan; a converged plan returns
-/// early, and the lock-step clock charges the time it took) and no duty-cycle cap beyond
-/// one core over a minute.
+/// The planner configuration the harness flies with: the deployment defaults
+/// (`planner.toml`: its budgets, compute gate and triggers), with a faster heartbeat. What
+/// users run is what a flight measures; a plan its deadline cuts carries its cuts, and
+/// `replay` takes them again (docs/ARCHITECTURE.md, "Deadline cuts").
 pub fn harness_planner_config(vehicle_id: &str) -> ServiceConfig {
     let mut c = ServiceConfig {
         vehicle_id: vehicle_id.to_string(),
         ..ServiceConfig::default()
     };
-    c.budget.plan_2d_ms = 2_000;
-    c.budget.plan_3d_ms = 6_000;
-    c.budget.replan_2d_ms = 2_000;
-    c.budget.replan_3d_ms = 6_000;
-    c.budget.duty_cycle = 1.0;
-    c.budget.duty_window_ms = 60_000;
     c.status.heartbeat_ms = 200;
     c
 }

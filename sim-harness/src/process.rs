@@ -55,12 +55,13 @@ pub struct PlannerProcess {
 }
 
 impl PlannerProcess {
-    /// Starts `binary serve --config config --vehicle vehicle_id`, stdout and stderr into
-    /// `log`.
+    /// Starts `binary serve --config config --vehicle vehicle_id` (and `replay_cuts`:
+    /// `--replay-cuts FILE`), stdout and stderr into `log`.
     pub fn spawn(
         binary: &Path,
         config: &Path,
         vehicle_id: &str,
+        replay_cuts: Option<&Path>,
         log: &Path,
     ) -> Result<PlannerProcess, ProcessError> {
         if !binary.is_file() {
@@ -77,6 +78,11 @@ impl PlannerProcess {
             .arg("--config")
             .arg(config)
             .args(["--vehicle", vehicle_id])
+            .args(
+                replay_cuts
+                    .iter()
+                    .flat_map(|p| [Path::new("--replay-cuts"), p]),
+            )
             .env(
                 "RUST_LOG",
                 std::env::var("RUST_LOG").unwrap_or_else(|_| "info".into()),

@@ -18,6 +18,8 @@ use std::time::Duration;
 
 use wingman_interfaces::{Plan, Wire};
 use wingman_ipc::ServiceConfig;
+use wingman_planning::cuts::ReplayCuts;
+use wingman_planning::plan_message::cuts_of;
 
 use crate::flight_log::{self, Direction, Entry, LogWriter};
 use crate::link::PlannerLink;
@@ -37,6 +39,11 @@ pub enum ReplayError {
     Service(String),
     #[error("{0}")]
     Process(#[from] ProcessError),
+    #[error(
+        "plan {plan_id} carries a deadline cut of unknown site {code:#010x}: the log was flown \
+         with another version of the planner"
+    )]
+    UnknownCut { plan_id: u64, code: u32 },
     #[error(
         "a resumed flight's log (taken over at mission time {mission_s:.1} s from a planner on plan {plan_id}): \
          the planner's world before the resume is not in it, so its plans cannot be replayed"
@@ -129,16 +136,20 @@ struct ReplayPlanner {
 }
 
 impl ReplayPlanner {
-    fn start(config: &ServiceConfig) -> Result<ReplayPlanner, ReplayError> {
+    /// Starts the planner with `config`, taking the logged plans' deadline cuts.
+    fn start(config: &ServiceConfig, cuts: &ReplayCuts) -> Result<ReplayPlanner, ReplayError> {
         let dir = std::env::temp_dir().join(format!("wingman-{}", config.vehicle_id));
         let io = |e: std::io::Error| ReplayError::Service(format!("{}: {e}", dir.display()));
         std::fs::create_dir_all(&dir).map_err(io)?;
         let config_path = dir.join("planner.toml");
         std::fs::write(&config_path, config.to_toml()).map_err(io)?;
+        let cuts_path = dir.join("replay-cuts.txt");
+        std::fs::write(&cuts_path, cuts.to_text()).map_err(io)?;
         let process = PlannerProcess::spawn(
             &planner_binary()?,
             &config_path,
             &config.vehicle_id,
+            Some(&cuts_path),
             &dir.join("planner.log"),
         )?;
         Ok(ReplayPlanner { process, dir })
@@ -165,6 +176,20 @@ impl Drop for ReplayPlanner {
         self.process.kill();
         let _ = std::fs::remove_dir_all(&self.dir);
     }
+}
+
+/// The deadline cuts of the logged plans, which the replay's planner takes instead of its
+/// own deadlines: a plan cut by its deadline in flight takes the same course again.
+fn replay_cuts(logged: &[Box<Plan>]) -> Result<ReplayCuts, ReplayError> {
+    let mut cuts = ReplayCuts::default();
+    for plan in logged {
+        let of_plan = cuts_of(plan).map_err(|code| ReplayError::UnknownCut {
+            plan_id: plan.plan_id,
+            code,
+        })?;
+        cuts.insert(plan.plan_id, of_plan);
+    }
+    Ok(cuts)
 }
 
 /// The bytes of a plan with `compute_ms` zeroed.
@@ -216,9 +241,10 @@ pub fn replay(log: &Path, timeout: Duration) -> Result<ReplayOutcome, ReplayErro
     config.vehicle_id = unique_vehicle_id("replay");
     let lock_step = entries.iter().any(|e| matches!(e, Entry::Sync { .. }));
     let logged: Vec<Box<Plan>> = flight_log::plans(&entries).collect();
+    let cuts = replay_cuts(&logged)?;
 
     let mut link = PlannerLink::open(&config.vehicle_id, LogWriter::discard())?;
-    let mut planner = ReplayPlanner::start(&config)?;
+    let mut planner = ReplayPlanner::start(&config, &cuts)?;
     let mut replayed: Vec<Box<Plan>> = Vec::new();
     let up = std::time::Instant::now();
     while link.status().is_none() {

@@ -4,7 +4,7 @@
 //! from the plans alone.
 
 use serde::Serialize;
-use wingman_interfaces::{Model, Objective, Quality, Trigger};
+use wingman_interfaces::{Model, Objective, PlanPath, Quality, Trigger};
 use wingman_planning::metrics::{TargetMiss, simpson, target_misses};
 use wingman_planning::threat::{ExposureAcc, Superquadric, ThreatError, ThreatLayout};
 
@@ -49,6 +49,11 @@ pub struct PlanOutcome {
     pub at_s: f64,
     pub trigger: String,
     pub quality: String,
+    /// The planner's path that made it (`Global`, `Warm`).
+    pub path: String,
+    /// Where its compute deadline cut it (0: nowhere; the plan is the same on any
+    /// machine).
+    pub cuts: u32,
     pub compute_ms: f64,
     pub cost: f64,
     pub start_s: f64,
@@ -104,6 +109,8 @@ pub struct Report {
     pub end_s: f64,
     pub flight_time_s: f64,
     pub targets: Vec<TargetOutcome>,
+    /// Where the aircraft was at `end_s` (x, y, z; z is 0 in 2-D), m.
+    pub end_position_m: [f64; 3],
     /// Distance from the final point (or the lead at `end_s`) at the end, m.
     pub final_error_m: f64,
     /// `end_s` minus the fixed final time (fixed-time missions), s.
@@ -390,6 +397,8 @@ pub fn build(flight: &Flight) -> Result<Report, ThreatError> {
                 at_s: q.created_at_s,
                 trigger: q.trigger().map_or("?", Trigger::name).to_string(),
                 quality: q.quality().map_or("?", Quality::name).to_string(),
+                path: q.path().map_or("?", PlanPath::name).to_string(),
+                cuts: q.cut_count,
                 compute_ms: q.compute_ms,
                 cost: q.cost,
                 start_s: q.start_time_s,
@@ -435,6 +444,7 @@ pub fn build(flight: &Flight) -> Result<Report, ThreatError> {
         end_s: end_t,
         flight_time_s: end_t - sc.start.time_s,
         targets: m.targets,
+        end_position_m: end_pos,
         final_error_m,
         final_time_error_s,
         min_f_static: min_of("static"),

@@ -54,6 +54,7 @@ fn planar_plan(problem: &Problem, plan_id: u64, t0: f64, x0: [f64; 3], len_s: f6
         },
         quality: Quality::Optimal,
         model: Model::TwoD,
+        path: wingman_interfaces::PlanPath::Global,
         created_at_s: t0,
         cost: 1.0,
         compute_ms: 100.0,

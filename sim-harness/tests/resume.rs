@@ -67,6 +67,7 @@ fn straight_plan(plan_id: u64, t0: f64, points: &[[f64; 2]]) -> Box<Plan> {
         trigger: Trigger::Initial,
         quality: Quality::Optimal,
         model: Model::TwoD,
+        path: wingman_interfaces::PlanPath::Global,
         created_at_s: t0,
         cost: 1.0,
         compute_ms: 1.0,

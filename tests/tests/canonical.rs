@@ -1,6 +1,6 @@
 //! Every canonical scenario (`scenarios/*.toml`) flown end to end with the real binaries
 //! — `wingman-harness fly-all`, a `wingman-planner serve` child per flight on a fresh
-//! vehicle id, the fast lock-step clock, the harness's converging budgets — with each
+//! vehicle id, the fast lock-step clock, the deployment defaults of `planner.toml` — with each
 //! flight's outcome asserted from its `report.json`: targets and the end within 100 m,
 //! min F ≥ 1 on avoidable layouts, no hold, every scheduled `t_r` followed by its
 //! re-plan, every log replayed byte-identical, and `3d-replan-popups` re-planning for

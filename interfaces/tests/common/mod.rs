@@ -135,6 +135,16 @@ pub fn plan() -> Plan {
     m.phase_count = 2;
     m.sample_count = 3;
     m.has_next_replan = 1;
+    m.path = PlanPath::Warm.to_wire();
+    m.cut_count = 2;
+    m.cuts[0] = PlanCut {
+        site: 0x0207_0003,
+        step: 0,
+    };
+    m.cuts[1] = PlanCut {
+        site: 0x0203_0000,
+        step: 41,
+    };
     m.created_at_s = 60.0;
     m.start_time_s = 60.25;
     m.valid_until_s = 95.0;

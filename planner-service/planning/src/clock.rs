@@ -4,6 +4,8 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
+use crate::cuts::{CutLog, Part, Site, Work};
+
 /// A monotonic clock.
 pub trait Clock: Send + Sync {
     /// Time since an arbitrary fixed origin.
@@ -71,11 +73,15 @@ impl Clock for TickingClock {
     }
 }
 
-/// A point in a clock's time by which work must be done.
+/// A point in a clock's time by which work must be done, and the work it is for: where
+/// the deadline changes the course of a computation it is asked through [`Deadline::cuts`],
+/// which records the choice (or replays a logged one, `crate::cuts`).
 #[derive(Clone, Copy)]
 pub struct Deadline<'c> {
     clock: &'c dyn Clock,
     at: Duration,
+    log: Option<&'c CutLog>,
+    site: Site,
 }
 
 impl<'c> Deadline<'c> {
@@ -84,12 +90,64 @@ impl<'c> Deadline<'c> {
         Deadline {
             clock,
             at: clock.now().saturating_add(budget),
+            log: None,
+            site: Site::PLAN,
         }
     }
 
     /// No deadline (a budget of about a century).
     pub fn never(clock: &'c dyn Clock) -> Self {
         Self::after(clock, Duration::from_secs(3_000_000_000))
+    }
+
+    /// This deadline with its cuts recorded in (or replayed from) `log`.
+    pub fn with_cuts(self, log: &'c CutLog) -> Self {
+        Deadline {
+            log: Some(log),
+            ..self
+        }
+    }
+
+    /// This deadline for the whole of path `part`.
+    pub fn within(self, part: Part) -> Self {
+        Deadline {
+            site: Site {
+                part,
+                work: Work::Whole,
+            },
+            ..self
+        }
+    }
+
+    /// This deadline for `work` of the same path.
+    pub fn at(self, work: Work) -> Self {
+        Deadline {
+            site: self.site.with(work),
+            ..self
+        }
+    }
+
+    /// The work this deadline is for.
+    pub fn site(&self) -> Site {
+        self.site
+    }
+
+    /// Whether the deadline cuts this work at `step` (iterations, rounds or seeds done;
+    /// 0 for a choice or for work not started): `live(self)`, the clock's answer, or in a
+    /// replay the logged one (see `crate::cuts`).
+    pub fn cuts(&self, step: u32, live: impl FnOnce(&Self) -> bool) -> bool {
+        match self.log {
+            Some(log) => log.cuts(self.site, step, || live(self)),
+            None => live(self),
+        }
+    }
+
+    /// Records that this work was cut at `step` by other means (the solver's own
+    /// wall-time limit).
+    pub fn note_cut(&self, step: u32) {
+        if let Some(log) = self.log {
+            log.note(self.site, step);
+        }
     }
 
     /// Time left (zero once passed).
@@ -105,14 +163,17 @@ impl<'c> Deadline<'c> {
     /// A deadline `share` (0–1) of the remaining time from now, never later than this one.
     pub fn share(&self, share: f64) -> Deadline<'c> {
         let part = self.remaining().mul_f64(share.clamp(0.0, 1.0));
-        Deadline::after(self.clock, part)
+        Deadline {
+            at: self.clock.now().saturating_add(part),
+            ..*self
+        }
     }
 
     /// This deadline moved `by` earlier (time kept in reserve for the work after it).
     pub fn earlier(&self, by: Duration) -> Deadline<'c> {
         Deadline {
-            clock: self.clock,
             at: self.at.saturating_sub(by),
+            ..*self
         }
     }
 

@@ -30,6 +30,7 @@ use crate::basins;
 use crate::clock::Deadline;
 use crate::collocation::kkt::KktCache;
 use crate::collocation::{ExportSettings, Mesh, NlpStatus};
+use crate::cuts::{Part, Work};
 use crate::problem::Problem;
 use crate::swarm::{self, SwarmWorkspace};
 use crate::trajectory::Trajectory;
@@ -63,24 +64,8 @@ pub struct StageTimes {
     pub total: Duration,
 }
 
-/// Which path made the plan.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PlanPath {
-    /// The global search: seeds, swarm, ranked starts, finalists, refinement.
-    Global,
-    /// A re-plan's warm path: the plan in flight, cut at the new start and solved again.
-    Warm,
-}
-
-impl PlanPath {
-    /// The name in reports and logs.
-    pub fn name(self) -> &'static str {
-        match self {
-            PlanPath::Global => "global",
-            PlanPath::Warm => "warm",
-        }
-    }
-}
+/// Which path made the plan (the `Plan` message's `path`).
+pub use wingman_interfaces::PlanPath;
 
 /// What the NLP stage did.
 #[derive(Debug, Clone, PartialEq)]
@@ -216,23 +201,32 @@ impl Planner {
         self.check(settings)?;
         let clock = deadline.clock();
         let started = clock.now();
+        let warm_deadline = deadline.within(Part::Warm);
+        let global_deadline = deadline.within(Part::Global);
         let warm = match flying.and_then(|f| f.guess_for(problem).map(|g| (f, g))) {
-            Some((flying, guess)) => Some(self.warm(problem, settings, deadline, flying, guess)?),
+            Some((flying, guess)) => {
+                Some(self.warm(problem, settings, warm_deadline, flying, guess)?)
+            }
             None => None,
         };
         let mut outcome = match warm {
             // The global search could only return the swarm's path, which an NLP plan
             // beats: it is not run (both cores are left idle instead).
-            Some(warm) if warm.has_plan() && !self.global_nlp_fits(problem, settings, deadline) => {
+            Some(warm)
+                if warm.has_plan()
+                    && global_deadline
+                        .cuts(0, |d| !self.global_nlp_fits(problem, settings, *d)) =>
+            {
                 PlanOutcome::of_warm(warm)
             }
             Some(warm) => {
                 // A warm plan is a better floor than the coarse one.
-                let mut outcome = self.global(problem, settings, deadline, !warm.has_plan())?;
+                let floor_wanted = !warm.has_plan();
+                let mut outcome = self.global(problem, settings, global_deadline, floor_wanted)?;
                 outcome.offer(warm);
                 outcome
             }
-            None => self.global(problem, settings, deadline, true)?,
+            None => self.global(problem, settings, global_deadline, true)?,
         };
         outcome.times.total = clock.now().saturating_sub(started);
         Ok(outcome)
@@ -292,6 +286,8 @@ fn gather<'a>(
     done: schedule::Schedule<NlpStage<'a>>,
     deadline: Deadline<'static>,
 ) -> Result<Gathered, PlanError> {
+    // The candidate whose final won: the rounds descend from it.
+    let winner = done.winner.map_or(0, |k| done.chosen[k]);
     let mut report = NlpReport {
         status: None,
         iterations: Vec::new(),
@@ -352,10 +348,14 @@ fn gather<'a>(
         };
         let next = if round == 0 {
             round_result.take()
-        } else if current.quality != Quality::Optimal || deadline.expired() {
+        } else if current.quality != Quality::Optimal
+            || deadline
+                .at(Work::Refinement)
+                .cuts(round as u32, Deadline::expired)
+        {
             break;
         } else {
-            stage.round_after(round, current, mesh, false, None)
+            stage.round_after(round, winner, current, mesh, false, None)
         };
         let Some((result, next, done_at)) = next else {
             break;

@@ -10,6 +10,7 @@
 pub mod basins;
 pub mod clock;
 pub mod collocation;
+pub mod cuts;
 pub mod dynamics;
 pub mod estimation;
 pub mod hybrid;

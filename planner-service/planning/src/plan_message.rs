@@ -6,9 +6,11 @@
 //! Allocation-free: the sample times are written straight into the message.
 
 use wingman_interfaces::{
-    Header, MAX_PHASES, MAX_PLAN_SAMPLES, Message, Model, Plan, PlanSample, Quality, Trigger,
-    ValidationError,
+    Header, MAX_PHASES, MAX_PLAN_CUTS, MAX_PLAN_SAMPLES, Message, Model, Plan, PlanCut, PlanPath,
+    PlanSample, Quality, Trigger, ValidationError,
 };
+
+use crate::cuts::{Cut, Site};
 
 use crate::dynamics::{Planar, Spatial};
 use crate::replan::PlanPoint;
@@ -24,6 +26,8 @@ pub struct PlanInfo {
     pub trigger: Trigger,
     pub quality: Quality,
     pub model: Model,
+    /// The planner's path that made it.
+    pub path: PlanPath,
     /// Mission time of the trigger.
     pub created_at_s: f64,
     pub cost: f64,
@@ -119,6 +123,9 @@ pub fn write_plan(
     out.phase_count = tr.phase_ends.len() as u32;
     out.has_next_replan = 0;
     out.next_replan_s = 0.0;
+    out.path = info.path.to_wire();
+    out.cut_count = 0;
+    out.cuts = [PlanCut { site: 0, step: 0 }; MAX_PLAN_CUTS];
     out.created_at_s = info.created_at_s;
     out.cost = info.cost;
     out.compute_ms = info.compute_ms;
@@ -168,6 +175,33 @@ pub fn set_next_replan(plan: &mut Plan, t_r: Option<f64>) {
             plan.valid_until_s = plan.final_time_s;
         }
     }
+}
+
+/// Writes the plan's deadline cuts (sorted, as `CutLog::finish` gives them); the number
+/// that did not fit (a replay of the plan then cannot take its course).
+pub fn set_cuts(plan: &mut Plan, cuts: &[Cut]) -> usize {
+    let kept = cuts.len().min(MAX_PLAN_CUTS);
+    for (slot, cut) in plan.cuts.iter_mut().zip(&cuts[..kept]) {
+        *slot = PlanCut {
+            site: cut.site.code(),
+            step: cut.step,
+        };
+    }
+    plan.cut_count = kept as u32;
+    cuts.len() - kept
+}
+
+/// The deadline cuts a plan carries, for a replay (an unknown site code is an error: the
+/// plan was made by another version of the planner).
+pub fn cuts_of(plan: &Plan) -> Result<Vec<Cut>, u32> {
+    plan.cuts()
+        .iter()
+        .map(|c| {
+            Site::from_code(c.site)
+                .map(|site| Cut { site, step: c.step })
+                .ok_or(c.site)
+        })
+        .collect()
 }
 
 /// State (model order, zero-padded) of a plan at time `t`, linear between samples and

@@ -74,17 +74,17 @@ pub fn seeds(
     settings: &SeedSettings,
     out: &mut Vec<Seed>,
 ) -> Result<(), SeedError> {
-    seeds_until(problem, settings, out, &|| false)
+    seeds_until(problem, settings, out, &|_| false)
 }
 
-/// [`seeds`], but once `stop()` says so (checked before each seed is built, after the
-/// first) the seeds not yet built are left out: the most promising come first (the
+/// [`seeds`], but once `stop(tried)` says so (checked before each seed is built, after the
+/// first; `tried`: the specs tried so far) the seeds not yet built are left out: the most promising come first (the
 /// scan's, cheapest first, then the arcs, the fixed-time fits, the random curves).
 pub fn seeds_until(
     problem: &Problem,
     settings: &SeedSettings,
     out: &mut Vec<Seed>,
-    stop: &dyn Fn() -> bool,
+    stop: &dyn Fn(u32) -> bool,
 ) -> Result<(), SeedError> {
     settings.validate()?;
     let ctx = Context::new(problem, settings)?;
@@ -92,8 +92,8 @@ pub fn seeds_until(
     let specs = families::specs(&ctx, settings, &mut rng);
 
     let mut count = 0;
-    for spec in &specs {
-        if count > 0 && stop() {
+    for (tried, spec) in specs.iter().enumerate() {
+        if count > 0 && stop(tried as u32) {
             break;
         }
         if out.len() <= count {

@@ -202,6 +202,7 @@ impl MessageLoop {
         let solver = Solver::spawn(
             settings,
             options.clock,
+            options.replay_cuts.clone(),
             Box::new(move || solver_waker(&vehicle)),
         )?;
         let gate = ComputeGate::new(GateSettings {

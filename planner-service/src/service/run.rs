@@ -21,6 +21,7 @@ use super::solver::SolverStartError;
 use wingman_ipc::config::{ConfigError, ServiceConfig};
 use wingman_ipc::{self as ipc, Ipc, IpcError};
 use wingman_planning::clock::Clock;
+use wingman_planning::cuts::ReplayCuts;
 
 /// A request to stop the service, from another thread (tests; `main` uses signals).
 #[derive(Debug, Clone, Default)]
@@ -51,6 +52,9 @@ pub struct RunOptions {
     /// Stop on SIGINT/SIGTERM (iceoryx2's signal handling). Off in in-process tests.
     pub handle_signals: bool,
     pub shutdown: Shutdown,
+    /// A replay: plan with no deadline, taking these logged deadline cuts
+    /// (`wingman_planning::cuts`).
+    pub replay_cuts: Option<ReplayCuts>,
 }
 
 /// Why [`run`] returned.

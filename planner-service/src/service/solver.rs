@@ -7,6 +7,10 @@
 //! At most one request is in flight: the request channel holds one, and the message thread
 //! sends the next only after it took the previous result. A panic inside the planner is
 //! caught, reported as [`SolveError::Panicked`], and the planner rebuilt.
+//!
+//! Each plan's deadline cuts (`wingman_planning::cuts`) are recorded and sent back with
+//! it; a replay (`replay`: the logged cuts of a flight's plans) plans with no deadline and
+//! takes the logged cuts instead.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::thread::JoinHandle;
@@ -17,6 +21,7 @@ use tracing::{error, info, info_span};
 use wingman_interfaces::Trigger;
 
 use wingman_planning::clock::{Clock, Deadline};
+use wingman_planning::cuts::{Cut, CutLog, ReplayCuts};
 use wingman_planning::hybrid::{FlyingPlan, PlanError, PlanOutcome, Planner, PlannerSettings};
 use wingman_planning::problem::Problem;
 
@@ -69,6 +74,8 @@ pub struct SolveResult {
     /// and of the NLP starts), at least the wall time; `threads x` the wall time if the
     /// CPU clock cannot be read.
     pub core_time: Duration,
+    /// Where the deadline cut the plan (sorted).
+    pub cuts: Vec<Cut>,
 }
 
 /// Builds, on the solve thread, the function that wakes the message thread after each
@@ -96,6 +103,7 @@ impl Solver {
     pub fn spawn(
         settings: PlannerSettings,
         clock: &'static dyn Clock,
+        replay: Option<ReplayCuts>,
         waker: WakerFactory,
     ) -> Result<Solver, SolverStartError> {
         let (req_tx, req_rx) = channel::bounded::<SolveRequest>(1);
@@ -114,7 +122,14 @@ impl Solver {
                         return;
                     }
                 };
-                solve_loop(&settings, clock, &req_rx, &res_tx, &mut *wake);
+                solve_loop(
+                    &settings,
+                    clock,
+                    replay.as_ref(),
+                    &req_rx,
+                    &res_tx,
+                    &mut *wake,
+                );
             })?;
         match ready_rx.recv() {
             Ok(Ok(())) => Ok(Solver {
@@ -211,11 +226,14 @@ pub const DROP_WAIT: Duration = Duration::from_secs(60);
 fn solve_loop(
     settings: &PlannerSettings,
     clock: &'static dyn Clock,
+    replay: Option<&ReplayCuts>,
     requests: &Receiver<SolveRequest>,
     results: &Sender<SolveResult>,
     wake: &mut dyn FnMut(),
 ) {
     let mut planner = Planner::new(settings);
+    // Deadlines need `'static` parts: one log for the thread's lifetime.
+    let cut_log: &'static CutLog = Box::leak(Box::new(CutLog::new()));
     // The last plan made, with its id: the plan in flight once the message thread took it.
     let mut last: Option<(u64, FlyingPlan)> = None;
     let threads = settings.swarm.threads.max(settings.threads).max(1) as u32;
@@ -238,8 +256,14 @@ fn solve_loop(
         let _entered = span.enter();
         let cpu_before = process_cpu_time();
         let started = clock.now();
-        let deadline =
-            Deadline::after(clock, ticket.budget).earlier(handover_margin(ticket.budget));
+        let logged = replay.map(|r| r.of(ticket.plan_id));
+        cut_log.begin(logged);
+        let deadline = match logged {
+            // A replay takes the logged cuts and no others.
+            Some(_) => Deadline::never(clock),
+            None => Deadline::after(clock, ticket.budget).earlier(handover_margin(ticket.budget)),
+        }
+        .with_cuts(cut_log);
         let flying = ticket
             .warm_from
             .and_then(|id| last.as_ref().filter(|(made, _)| *made == id))
@@ -255,6 +279,7 @@ fn solve_loop(
             }
         };
         let finished = clock.now();
+        let cuts = cut_log.finish();
         let wall = finished.saturating_sub(started);
         let core_time = match (cpu_before, process_cpu_time()) {
             (Some(a), Some(b)) => b.saturating_sub(a).max(wall),
@@ -271,6 +296,7 @@ fn solve_loop(
             Ok(o) => info!(
                 quality = o.quality.name(),
                 path = o.path.name(),
+                cuts = cuts.len(),
                 warm_ms = ms(o.times.warm),
                 first_optimal_ms = o.first_optimal.map_or(f64::NAN, ms),
                 cost = o.cost,
@@ -297,6 +323,7 @@ fn solve_loop(
             started,
             finished,
             core_time,
+            cuts,
         };
         if results.send(result).is_err() {
             return;

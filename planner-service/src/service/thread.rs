@@ -27,6 +27,7 @@ impl ServiceThread {
             clock,
             handle_signals: false,
             shutdown: shutdown.clone(),
+            replay_cuts: None,
         };
         let thread = std::thread::Builder::new()
             .name("planner-service".into())

@@ -35,6 +35,7 @@ impl Driven {
             clock,
             handle_signals: false,
             shutdown: Shutdown::new(),
+            replay_cuts: None,
         };
         let ml = wingman_planner::service::MessageLoop::new(&options).expect("message loop");
         let h = FakeHarness::new(&v);

@@ -487,6 +487,7 @@ fn spawn_planner(
         &bin,
         config_path,
         vehicle,
+        None,
         &opts.out_dir.join(log_name),
     )?)
 }

@@ -121,6 +121,9 @@ struct Adapter {
     has_best: bool,
     solution: Option<PrimalDual>,
     iterations: usize,
+    /// Calls of the intermediate callback (restoration's included): the step at which
+    /// the deadline cuts the solve (`crate::cuts`).
+    callbacks: u32,
     /// When the solve began, and when the last iteration ended (deadline clock).
     began: Duration,
     last_iteration_end: Duration,
@@ -268,13 +271,19 @@ impl TNLP for Adapter {
             self.longest_iteration = self.longest_iteration.max(took);
         }
         self.last_iteration_end = now;
+        self.callbacks += 1;
         let budget = &self.budget;
         let cancelled = budget
             .cancel
             .as_ref()
             .is_some_and(|c| c.load(Ordering::Relaxed));
+        if cancelled {
+            return false;
+        }
         let next = self.longest_iteration.max(budget.iteration);
-        !cancelled && budget.deadline.remaining() > next + budget.wrap_up
+        !budget
+            .deadline
+            .cuts(self.callbacks, |d| d.remaining() <= next + budget.wrap_up)
     }
 }
 
@@ -492,6 +501,7 @@ pub fn solve(
         has_best: false,
         solution: None,
         iterations: 0,
+        callbacks: 0,
         began,
         last_iteration_end: began,
         first_iteration: None,
@@ -506,6 +516,14 @@ pub fn solve(
         // The application let go of the problem when dropped; if it did not, copy it out.
         Err(rc) => rc.borrow().clone(),
     };
+    if matches!(
+        return_status,
+        ApplicationReturnStatus::MaximumWallTimeExceeded
+            | ApplicationReturnStatus::MaximumCpuTimeExceeded
+    ) {
+        // The backstop stopped it after this callback: a replay stops it there.
+        deadline.note_cut(a.callbacks);
+    }
     let status = match return_status {
         ApplicationReturnStatus::SolveSucceeded
         | ApplicationReturnStatus::SolvedToAcceptableLevel => NlpStatus::Converged,

@@ -15,6 +15,7 @@ use super::{
 use crate::basins;
 use crate::clock::Deadline;
 use crate::collocation::{export, fly_reference};
+use crate::cuts::Work;
 use crate::problem::Problem;
 use crate::swarm::{self, SwarmOutcome};
 use crate::trajectory::Trajectory;
@@ -71,7 +72,8 @@ impl Planner {
         // it): first the floor, one coarse solve of the swarm's path, kept if the stage
         // yields nothing.
         let short = !stage_timing.fits_the_stage(&timing, deadline.remaining() / 3);
-        let floor = if floor_wanted && short && timing.fits_a_solve(deadline.remaining()) {
+        let floor_runs = |d: &Deadline<'static>| short && timing.fits_a_solve(d.remaining());
+        let floor = if floor_wanted && deadline.at(Work::Floor).cuts(0, floor_runs) {
             Some(nlp_stage::floor(
                 problem, settings, &sw.best, deadline, timing, &self.kkt,
             ))
@@ -82,7 +84,9 @@ impl Planner {
         // recent plans measured them): no NLP stage at all, not even its starts (2-3 ms of
         // dense costs). (An expired deadline is one of these.) Asked again now: a swarm
         // that converged early may have left the time for it.
-        let no_time = !stage_timing.fits_the_stage(&timing, deadline.remaining());
+        let no_time = deadline
+            .at(Work::NlpStage)
+            .cuts(0, |d| !stage_timing.fits_the_stage(&timing, d.remaining()));
         let starts = if no_time {
             Vec::new()
         } else {

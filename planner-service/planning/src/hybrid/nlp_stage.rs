@@ -17,6 +17,7 @@ use crate::collocation::{
     ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, SolveBudget, Transcription, export,
     interval_errors, refine, solve, split_crossings,
 };
+use crate::cuts::Work;
 use crate::problem::Problem;
 use crate::trajectory::Trajectory;
 
@@ -76,7 +77,7 @@ pub(super) fn solve_on_mesh(
         start_x,
         cancel,
     } = job;
-    if !timing.fits_a_solve(deadline.remaining()) {
+    if deadline.cuts(0, |d| !timing.fits_a_solve(d.remaining())) {
         // No time for even one iteration (the longest set-up and first iteration of
         // recent solves): do not build the NLP; the caller returns what it has.
         return Ok((None, 0, NlpStatus::MaxTime, SolveTiming::default()));
@@ -166,6 +167,7 @@ pub(super) fn floor(
         start_x: None,
         cancel: None,
     };
+    let deadline = deadline.at(Work::FloorSolve);
     (solve_on_mesh(job, deadline, timing, kkt), mesh)
 }
 
@@ -228,11 +230,11 @@ pub(super) struct NlpStage<'a> {
 }
 
 impl NlpStage<'_> {
-    /// Runs `job` with the timing known now (recent plans' and this one's so far), and
-    /// records its own.
-    fn solve(&self, job: MeshSolve<'_>) -> MeshSolveResult {
+    /// Runs `job` (the stage's `work`) with the timing known now (recent plans' and this
+    /// one's so far), and records its own.
+    fn solve(&self, work: Work, job: MeshSolve<'_>) -> MeshSolveResult {
         let timing = self.timing.max(self.seen.get());
-        let result = solve_on_mesh(job, self.deadline, timing, self.kkt);
+        let result = solve_on_mesh(job, self.deadline.at(work), timing, self.kkt);
         if let Ok((_, _, _, seen)) = &result {
             self.seen.record(*seen);
         }
@@ -245,11 +247,13 @@ impl NlpStage<'_> {
         self.settings.finalist_nlp.tol > self.settings.nlp.tol
     }
 
-    /// Refinement round `round` after `current`, solved on `mesh`: the refined mesh, or
-    /// (`polish`) the same mesh from `current`'s own solution.
+    /// Refinement round `round` after `current` (descended from candidate `candidate`'s
+    /// final), solved on `mesh`: the refined mesh, or (`polish`) the same mesh from
+    /// `current`'s own solution.
     pub(super) fn round_after(
         &self,
         round: usize,
+        candidate: usize,
         current: &Solved,
         mesh: &Mesh,
         polish: bool,
@@ -270,19 +274,26 @@ impl NlpStage<'_> {
         };
         let mut guess = Trajectory::default();
         export(&current.tr, &current.x, &self.reference, &mut guess);
-        let result = self.solve(MeshSolve {
-            problem: self.problem,
-            mesh: &next,
-            guess: &guess,
-            settings,
-            nlp_settings: &settings.nlp,
-            refined: true,
-            feasibility_tol: settings.nlp.feasibility_tol,
-            warm_from: warm_start_of(Some(current), settings.warm_mesh_changes),
-            mu_init: None,
-            start_x: same.then_some(current.x.as_slice()),
-            cancel,
-        });
+        let work = Work::Round {
+            candidate: candidate as u8,
+            round: round as u8,
+        };
+        let result = self.solve(
+            work,
+            MeshSolve {
+                problem: self.problem,
+                mesh: &next,
+                guess: &guess,
+                settings,
+                nlp_settings: &settings.nlp,
+                refined: true,
+                feasibility_tol: settings.nlp.feasibility_tol,
+                warm_from: warm_start_of(Some(current), settings.warm_mesh_changes),
+                mu_init: None,
+                start_x: same.then_some(current.x.as_slice()),
+                cancel,
+            },
+        );
         Some((result, next, self.deadline.clock().now()))
     }
 }
@@ -298,19 +309,22 @@ impl schedule::Stage for NlpStage<'_> {
 
     fn rank(&self, i: usize) -> Ranked {
         let (problem, settings) = (self.problem, self.settings);
-        let result = self.solve(MeshSolve {
-            problem,
-            mesh: &self.coarse[i],
-            guess: &self.starts[i],
-            settings,
-            nlp_settings: &settings.ranking_nlp,
-            refined: false,
-            feasibility_tol: settings.ranking_feasibility_tol,
-            warm_from: None,
-            mu_init: ranking_mu_init(problem, settings),
-            start_x: None,
-            cancel: None,
-        });
+        let result = self.solve(
+            Work::Rank(i as u16),
+            MeshSolve {
+                problem,
+                mesh: &self.coarse[i],
+                guess: &self.starts[i],
+                settings,
+                nlp_settings: &settings.ranking_nlp,
+                refined: false,
+                feasibility_tol: settings.ranking_feasibility_tol,
+                warm_from: None,
+                mu_init: ranking_mu_init(problem, settings),
+                start_x: None,
+                cancel: None,
+            },
+        );
         let path = accepted_of(&result).map(|s| {
             let mut tr = Trajectory::default();
             export(&s.tr, &s.x, &self.reference, &mut tr);
@@ -332,7 +346,7 @@ impl schedule::Stage for NlpStage<'_> {
         finalists(&order, self.settings)
     }
 
-    fn finalist(&self, _c: usize, rank: Option<&Ranked>, cancel: Arc<AtomicBool>) -> Finaled {
+    fn finalist(&self, c: usize, rank: Option<&Ranked>, cancel: Arc<AtomicBool>) -> Finaled {
         let settings = self.settings;
         // A finalist starts from its coarse solution; the fallback from its own start.
         let (guess, coarse) = match rank.and_then(|r| r.path.as_ref().map(|p| (&p.1, r))) {
@@ -351,19 +365,22 @@ impl schedule::Stage for NlpStage<'_> {
         {
             mesh = split;
         }
-        let result = self.solve(MeshSolve {
-            problem: self.problem,
-            mesh: &mesh,
-            guess,
-            settings,
-            nlp_settings: &settings.finalist_nlp,
-            refined: true,
-            feasibility_tol: settings.nlp.feasibility_tol,
-            warm_from: warm_start_of(coarse, settings.warm_mesh_changes),
-            mu_init: None,
-            start_x: None,
-            cancel: Some(cancel),
-        });
+        let result = self.solve(
+            Work::Final(c as u16),
+            MeshSolve {
+                problem: self.problem,
+                mesh: &mesh,
+                guess,
+                settings,
+                nlp_settings: &settings.finalist_nlp,
+                refined: true,
+                feasibility_tol: settings.nlp.feasibility_tol,
+                warm_from: warm_start_of(coarse, settings.warm_mesh_changes),
+                mu_init: None,
+                start_x: None,
+                cancel: Some(cancel),
+            },
+        );
         Finaled {
             result,
             mesh,
@@ -376,13 +393,18 @@ impl schedule::Stage for NlpStage<'_> {
         accepted_of(&f.result).map(|s| (s.objective, s.quality == Quality::Optimal && rounds > 0))
     }
 
-    fn round(&self, _c: usize, f: &Finaled, cancel: Arc<AtomicBool>) -> Rounded {
+    fn round(&self, c: usize, f: &Finaled, cancel: Arc<AtomicBool>) -> Rounded {
         let current = accepted_of(&f.result)?;
-        self.round_after(0, current, &f.mesh, self.polish(), Some(cancel))
+        self.round_after(0, c, current, &f.mesh, self.polish(), Some(cancel))
     }
 
     fn expired(&self) -> bool {
         self.deadline.expired()
+    }
+
+    fn round_cut(&self, started: bool) -> bool {
+        let deadline = self.deadline.at(Work::WinnerRound);
+        deadline.cuts(0, |d| !started && d.expired())
     }
 
     fn now(&self) -> Duration {

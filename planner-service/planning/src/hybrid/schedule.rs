@@ -46,8 +46,11 @@ pub(super) trait Stage: Sync {
     fn judge(&self, f: &Self::Final) -> Option<(f64, bool)>;
     /// The first round after candidate `c`'s final `f`.
     fn round(&self, c: usize, f: &Self::Final, cancel: Arc<AtomicBool>) -> Self::Round;
-    /// The plan's deadline has passed (no new round is started).
+    /// The plan's deadline has passed (no speculative task is started).
     fn expired(&self) -> bool;
+    /// Whether the deadline cuts the winner's first round (`started`: it is already
+    /// running, speculatively), recorded as a deadline cut (`crate::cuts`).
+    fn round_cut(&self, started: bool) -> bool;
     /// The stage clock's time.
     fn now(&self) -> Duration;
 }
@@ -198,7 +201,7 @@ impl<S: Stage> Shared<S> {
                 let best = self.best_final(board, &chosen, stage);
                 board.wanted_round = best
                     .filter(|&(k, round)| {
-                        round && (!stage.expired() || board.rounds[chosen[k]] != State::Idle)
+                        round && !stage.round_cut(board.rounds[chosen[k]] != State::Idle)
                     })
                     .map(|(k, _)| chosen[k]);
                 for (c, cancel) in self.cancel_round.iter().enumerate() {
@@ -458,6 +461,10 @@ mod tests {
 
         fn expired(&self) -> bool {
             false
+        }
+
+        fn round_cut(&self, started: bool) -> bool {
+            !started && self.expired()
         }
 
         fn now(&self) -> Duration {

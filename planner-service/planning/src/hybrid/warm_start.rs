@@ -19,6 +19,7 @@ use crate::basins;
 use crate::clock::Deadline;
 use crate::collocation::export;
 use crate::collocation::transcription::nearest_turn;
+use crate::cuts::Work;
 use crate::problem::{Problem, Threats};
 use crate::seeding;
 use crate::swarm::SwarmError;
@@ -141,8 +142,9 @@ fn seed_starts(
         return Ok(Vec::new());
     }
     let mut seeds = Vec::new();
-    seeding::seeds_until(problem, &settings.swarm.seeds, &mut seeds, &|| {
-        deadline.expired()
+    let deadline = deadline.at(Work::Seeds);
+    seeding::seeds_until(problem, &settings.swarm.seeds, &mut seeds, &|tried| {
+        deadline.cuts(tried, Deadline::expired)
     })
     .map_err(SwarmError::from)?;
     let cost = |tr: &Trajectory| trajectory_cost(problem, tr);

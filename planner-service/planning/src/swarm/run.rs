@@ -11,6 +11,7 @@ use rand_chacha::ChaCha8Rng;
 use wingman_interfaces::Objective;
 
 use crate::clock::Deadline;
+use crate::cuts::Work;
 use crate::problem::Problem;
 use crate::seeding::{self, Seed};
 
@@ -40,8 +41,9 @@ pub fn run(
     ws.reserve(settings);
     ws.lookahead = settings.lookahead;
     // Under a deadline too short for them all, the most promising seeds only.
-    seeding::seeds_until(problem, &settings.seeds, &mut ws.seeds, &|| {
-        deadline.expired()
+    let seeds_deadline = deadline.at(Work::Seeds);
+    seeding::seeds_until(problem, &settings.seeds, &mut ws.seeds, &|tried| {
+        seeds_deadline.cuts(tried, Deadline::expired)
     })?;
     let dt = prepare_grid(problem, settings, &ws.seeds, &mut ws.grid)?;
     let dim = ws.grid.dim();
@@ -230,7 +232,8 @@ impl Swarm<'_> {
         };
         self.rank_seeds();
         // No time for the particles' first round: the best seed.
-        if self.deadline.remaining() <= round {
+        let rounds = self.deadline.at(Work::SwarmRounds);
+        if rounds.cuts(0, |d| d.remaining() <= round) {
             self.status = SwarmStatus::MaxTime;
             workers.stop();
             return true;
@@ -318,6 +321,7 @@ impl Swarm<'_> {
         let settings = self.settings;
         let mut stall = Stall::new(self.gscore, self.group_score);
         let mut last_left: Option<Duration> = None;
+        let rounds = self.deadline.at(Work::SwarmRounds);
         while alive {
             if self.iterations >= settings.max_iterations {
                 self.status = SwarmStatus::MaxIterations;
@@ -329,7 +333,8 @@ impl Swarm<'_> {
             if let Some(before) = last_left {
                 round = round.max(before.saturating_sub(left));
             }
-            if left <= round {
+            // Step 0 is before the particles' first round (above), k + 1 after k rounds.
+            if rounds.cuts(self.iterations as u32 + 1, |_| left <= round) {
                 self.status = SwarmStatus::MaxTime;
                 break;
             }

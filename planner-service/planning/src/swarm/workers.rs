@@ -6,6 +6,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use crate::clock::Deadline;
+use crate::cuts::Work;
 use crate::seeding::Seed;
 
 use super::eval::{self, Grid, Score, Scratch};
@@ -59,8 +60,10 @@ impl Shard {
     ) {
         let dim = g.dim();
         self.seed_scores.clear();
+        let deadline = deadline.at(Work::SeedScores(first as u8));
         for i in (first..seeds.len()).step_by(stride) {
-            if !self.seed_scores.is_empty() && deadline.expired() {
+            let scored = self.seed_scores.len() as u32;
+            if scored > 0 && deadline.cuts(scored, Deadline::expired) {
                 break;
             }
             let u = &mut self.seed_u[..dim];

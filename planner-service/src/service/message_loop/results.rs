@@ -9,6 +9,7 @@ use super::lifecycle::{FirstPlan, PlanLifecycle};
 use super::{FIRST_PLAN_RETRY, MessageLoop};
 use crate::service::solver::{SolveResult, Ticket};
 use crate::service::world::{self, ThreatSlot};
+use wingman_planning::cuts::Cut;
 use wingman_planning::hybrid::PlanOutcome;
 use wingman_planning::plan_message::{self as export, PlanInfo};
 
@@ -23,6 +24,7 @@ impl MessageLoop {
             started,
             finished,
             core_time,
+            cuts,
         } = result;
         self.lifecycle.plan_done();
         self.problem = Some(problem);
@@ -30,7 +32,7 @@ impl MessageLoop {
         let compute_ms = finished.saturating_sub(started).as_secs_f64() * 1e3;
         self.counters.last_compute_ms = compute_ms;
         match outcome {
-            Ok(o) => self.accept(&o, &ticket, compute_ms),
+            Ok(o) => self.accept(&o, &ticket, compute_ms, &cuts),
             Err(e) => {
                 warn!(trigger = ticket.trigger.name(), error = %e, "no plan made");
                 // Without a plan the status says `Degraded`; the first plan is tried again
@@ -82,7 +84,7 @@ impl MessageLoop {
     }
 
     /// Publishes a plan made by the solver and makes it current.
-    fn accept(&mut self, o: &PlanOutcome, ticket: &Ticket, compute_ms: f64) {
+    fn accept(&mut self, o: &PlanOutcome, ticket: &Ticket, compute_ms: f64, cuts: &[Cut]) {
         // The model and speed of the problem planned (the tasking may have changed since).
         let Some((model, speed)) = self.problem.as_ref().map(|p| (p.model, p.limits.speed)) else {
             error!(
@@ -96,6 +98,7 @@ impl MessageLoop {
             trigger: ticket.trigger,
             quality: o.quality,
             model,
+            path: o.path,
             created_at_s: ticket.created_at_s,
             cost: o.cost,
             compute_ms,
@@ -108,6 +111,14 @@ impl MessageLoop {
         if let Err(e) = export::write_plan(&mut self.scratch, header, &info, &o.trajectory) {
             error!(error = %e, "the plan cannot be exported; it is dropped");
             return;
+        }
+        let dropped = export::set_cuts(&mut self.scratch, cuts);
+        if dropped > 0 {
+            warn!(
+                dropped,
+                "the plan's deadline cuts do not all fit in the message: a replay cannot \
+                 take its course"
+            );
         }
         // Scheduled re-plans of the moving threats over the new plan.
         self.points.fill(&self.scratch, speed);

@@ -1,0 +1,110 @@
+//! Deadline cuts (`wingman_planning::cuts`): a plan that a short deadline cut, planned
+//! again with no deadline but its recorded cuts, is the same plan byte for byte — cold
+//! plans and warm re-plans, in 2-D and 3-D — and the replay takes exactly the recorded
+//! cuts. The cuts themselves depend on the machine's speed (this test does not pin them);
+//! what it checks is that they are all the plan depends on besides its inputs.
+
+use std::time::Duration;
+
+use wingman_planning::clock::Deadline;
+use wingman_planning::cuts::{Cut, CutLog};
+use wingman_planning::hybrid::{FlyingPlan, PlanOutcome, Planner, PlannerSettings};
+use wingman_planning::problem::{Problem, Threats};
+use wingman_planning::threat::Superquadric;
+
+mod common;
+use common::{clock, planned};
+
+/// Plans `p` under `budget` recording its cuts, then with no deadline replaying them:
+/// (the plan cut, the replay, the cuts recorded, the cuts the replay took).
+fn cut_and_replayed(
+    p: &Problem,
+    flying: Option<&FlyingPlan>,
+    budget: Duration,
+) -> (PlanOutcome, PlanOutcome, Vec<Cut>, Vec<Cut>) {
+    let log: &'static CutLog = Box::leak(Box::new(CutLog::new()));
+    log.begin(None);
+    let cut = plan_static(p, flying, Deadline::after(clock(), budget).with_cuts(log));
+    let recorded = log.finish();
+    log.begin(Some(&recorded));
+    let replayed = plan_static(p, flying, Deadline::never(clock()).with_cuts(log));
+    let taken = log.finish();
+    (cut, replayed, recorded, taken)
+}
+
+/// Plans `p` (re-plans it from `flying` if given) with a fresh planner under `deadline`.
+fn plan_static(
+    p: &Problem,
+    flying: Option<&FlyingPlan>,
+    deadline: Deadline<'static>,
+) -> PlanOutcome {
+    let settings = PlannerSettings::default();
+    let mut planner = Planner::new(&settings);
+    match flying {
+        Some(f) => planner.replan(p, &settings, deadline, f),
+        None => planner.plan(p, &settings, deadline),
+    }
+    .expect("a plan")
+}
+
+fn assert_same_plan(name: &str, a: &PlanOutcome, b: &PlanOutcome, recorded: &[Cut], taken: &[Cut]) {
+    assert!(
+        !recorded.is_empty(),
+        "{name}: the short deadline cut nothing (the test would prove nothing)"
+    );
+    assert_eq!(taken, recorded, "{name}: the replay took other cuts");
+    assert_eq!(a.quality, b.quality, "{name}");
+    assert_eq!(a.path, b.path, "{name}");
+    assert_eq!(a.cost.to_bits(), b.cost.to_bits(), "{name}");
+    assert_eq!(a.trajectory, b.trajectory, "{name}: {recorded:?}");
+}
+
+#[test]
+fn a_cold_plan_cut_short_replays_byte_for_byte() {
+    for (name, budget_ms) in [
+        ("2d-min-time-avoidable", 30),
+        ("3d-fixed-time-avoidable", 120),
+    ] {
+        let (p, _) = planned(name);
+        let (a, b, recorded, taken) = cut_and_replayed(&p, None, Duration::from_millis(budget_ms));
+        assert_same_plan(name, &a, &b, &recorded, &taken);
+    }
+}
+
+#[test]
+fn a_warm_re_plan_cut_short_replays_byte_for_byte() {
+    for (name, budget_ms) in [
+        ("2d-min-time-avoidable", 15),
+        ("3d-fixed-time-avoidable", 60),
+    ] {
+        let (take_off, path) = planned(name);
+        let flying = FlyingPlan::new(&take_off, path);
+        let tf = flying.path.final_time().unwrap();
+        let mut p = take_off.clone();
+        p.t0 = take_off.t0 + 0.2 * (tf - take_off.t0);
+        p.x0 = flying.path.at(p.t0).unwrap().0;
+        // A pop-up on the path ahead: the warm path ranks its bends (and seeds in 2-D).
+        let (ahead, _) = flying.path.at(p.t0 + 0.3 * (tf - p.t0)).unwrap();
+        match &mut p.threats {
+            Threats::Planar { layout, .. } => layout
+                .push(Superquadric::ellipsoid([ahead[0], ahead[1]], [4000.0, 4000.0]).unwrap())
+                .unwrap(),
+            Threats::Spatial { layout, .. } => layout
+                .push(
+                    Superquadric::ellipsoid(
+                        [ahead[0], ahead[1], ahead[2]],
+                        [4000.0, 4000.0, 3000.0],
+                    )
+                    .unwrap(),
+                )
+                .unwrap(),
+        }
+        let budget = Duration::from_millis(budget_ms);
+        let (a, b, recorded, taken) = cut_and_replayed(&p, Some(&flying), budget);
+        assert!(
+            a.warm.is_some(),
+            "{name}: the re-plan continues the plan in flight"
+        );
+        assert_same_plan(name, &a, &b, &recorded, &taken);
+    }
+}
