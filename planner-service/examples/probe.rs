@@ -277,7 +277,8 @@ fn main() {
                 let dir = std::path::Path::new(&dir).join(format!("{name}-{seed}"));
                 std::fs::create_dir_all(&dir).unwrap();
                 let sc = bundled(name).unwrap().unwrap();
-                wingman_planner::offline::write_outputs(&dir, &sc, &problem, &out).unwrap();
+                // The probe does not record deadline cuts: plan.json lists none.
+                wingman_planner::offline::write_outputs(&dir, &sc, &problem, &out, &[]).unwrap();
             }
             let ratio = out.cost / reference;
             ratios.push(ratio);

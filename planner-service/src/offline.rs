@@ -8,6 +8,7 @@ use serde_json::json;
 use wingman_interfaces::{Model, Quality};
 
 use wingman_planning::clock::{Clock, Deadline};
+use wingman_planning::cuts::{Cut, CutLog};
 use wingman_planning::hybrid::{PlanOutcome, Planner, PlannerSettings};
 use wingman_planning::problem::Problem;
 use wingman_planning::scenario::Scenario;
@@ -42,9 +43,20 @@ pub fn plan_scenario(
         .deadline
         .unwrap_or_else(|| default_deadline(problem.model));
     let mut planner = Planner::new(&settings);
-    let outcome = planner.plan(&problem, &settings, Deadline::after(clock, budget))?;
+    // Deadlines need `'static` parts; one small log per offline plan.
+    let log: &'static CutLog = Box::leak(Box::new(CutLog::new()));
+    log.begin(None);
+    let deadline = Deadline::after(clock, budget).with_cuts(log);
+    let outcome = planner.plan(&problem, &settings, deadline)?;
+    let cuts = log.finish();
     std::fs::create_dir_all(&request.out_dir)?;
-    write_outputs(&request.out_dir, &request.scenario, &problem, &outcome)?;
+    write_outputs(
+        &request.out_dir,
+        &request.scenario,
+        &problem,
+        &outcome,
+        &cuts,
+    )?;
     draw_plan(
         &request.out_dir.join("plan.png"),
         &request.scenario,
@@ -142,12 +154,14 @@ fn quality_name(q: Quality) -> &'static str {
     q.name()
 }
 
-/// Writes `plan.json` and `plan.csv` (the judge's format) of `outcome` into `dir`.
+/// Writes `plan.json` and `plan.csv` (the judge's format) of `outcome` into `dir`; `cuts`:
+/// where its deadline cut it.
 pub fn write_outputs(
     dir: &Path,
     sc: &Scenario,
     problem: &Problem,
     o: &PlanOutcome,
+    cuts: &[Cut],
 ) -> anyhow::Result<()> {
     let tr = &o.trajectory;
     std::fs::write(dir.join("plan.csv"), tr.to_csv(problem.model))?;
@@ -155,6 +169,8 @@ pub fn write_outputs(
     let doc = json!({
         "scenario": sc.name,
         "quality": quality_name(o.quality),
+        "path": o.path.name(),
+        "cuts": cuts.iter().map(ToString::to_string).collect::<Vec<_>>(),
         "cost": o.cost,
         "final_time_s": tr.final_time(),
         "phase_ends_s": tr.phase_ends,

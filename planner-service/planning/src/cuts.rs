@@ -143,6 +143,31 @@ pub struct Cut {
     pub step: u32,
 }
 
+impl std::fmt::Display for Cut {
+    /// `part/work@step`, as logs show it: `Global/Whole@0`, `Warm/Rank(2)@14`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:?}/{:?}@{}", self.site.part, self.site.work, self.step)
+    }
+}
+
+/// Cuts as logs show them: space-separated (`-` for none).
+pub struct CutList<'a>(pub &'a [Cut]);
+
+impl std::fmt::Display for CutList<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.0.is_empty() {
+            return write!(f, "-");
+        }
+        for (k, c) in self.0.iter().enumerate() {
+            if k > 0 {
+                write!(f, " ")?;
+            }
+            write!(f, "{c}")?;
+        }
+        Ok(())
+    }
+}
+
 /// What a [`CutLog`] does during one plan.
 #[derive(Debug)]
 enum Mode {
@@ -407,6 +432,13 @@ mod tests {
             ]
         );
         assert!(log.finish().is_empty(), "finish starts afresh");
+        let shown = CutList(&[Cut {
+            site: late,
+            step: 40,
+        }])
+        .to_string();
+        assert_eq!(shown, "Plan/SwarmRounds@40");
+        assert_eq!(CutList(&[]).to_string(), "-");
     }
 
     #[test]

@@ -21,7 +21,7 @@ use tracing::{error, info, info_span};
 use wingman_interfaces::Trigger;
 
 use wingman_planning::clock::{Clock, Deadline};
-use wingman_planning::cuts::{Cut, CutLog, ReplayCuts};
+use wingman_planning::cuts::{Cut, CutList, CutLog, ReplayCuts};
 use wingman_planning::hybrid::{FlyingPlan, PlanError, PlanOutcome, Planner, PlannerSettings};
 use wingman_planning::problem::Problem;
 
@@ -296,7 +296,7 @@ fn solve_loop(
             Ok(o) => info!(
                 quality = o.quality.name(),
                 path = o.path.name(),
-                cuts = cuts.len(),
+                cuts = %CutList(&cuts),
                 warm_ms = ms(o.times.warm),
                 first_optimal_ms = o.first_optimal.map_or(f64::NAN, ms),
                 cost = o.cost,
