@@ -19,7 +19,7 @@ use std::time::Duration;
 use wingman_interfaces::{Plan, Wire};
 use wingman_ipc::ServiceConfig;
 use wingman_planning::cuts::ReplayCuts;
-use wingman_planning::plan_message::cuts_of;
+use wingman_planning::plan_message::{TRUNCATED_CUTS, cuts_of};
 
 use crate::flight_log::{self, Direction, Entry, LogWriter};
 use crate::link::PlannerLink;
@@ -44,6 +44,11 @@ pub enum ReplayError {
          with another version of the planner"
     )]
     UnknownCut { plan_id: u64, code: u32 },
+    #[error(
+        "plan {plan_id} was cut by its deadline in more places than its message holds: its \
+         course cannot be replayed"
+    )]
+    TruncatedCuts { plan_id: u64 },
     #[error(
         "a resumed flight's log (taken over at mission time {mission_s:.1} s from a planner on plan {plan_id}): \
          the planner's world before the resume is not in it, so its plans cannot be replayed"
@@ -183,9 +188,10 @@ impl Drop for ReplayPlanner {
 fn replay_cuts(logged: &[Box<Plan>]) -> Result<ReplayCuts, ReplayError> {
     let mut cuts = ReplayCuts::default();
     for plan in logged {
-        let of_plan = cuts_of(plan).map_err(|code| ReplayError::UnknownCut {
-            plan_id: plan.plan_id,
-            code,
+        let plan_id = plan.plan_id;
+        let of_plan = cuts_of(plan).map_err(|code| match code {
+            TRUNCATED_CUTS => ReplayError::TruncatedCuts { plan_id },
+            code => ReplayError::UnknownCut { plan_id, code },
         })?;
         cuts.insert(plan.plan_id, of_plan);
     }

@@ -150,6 +150,13 @@ impl<'c> Deadline<'c> {
         }
     }
 
+    /// Forgets the cuts this work took (its result is not used).
+    pub fn forget_cuts(&self) {
+        if let Some(log) = self.log {
+            log.forget(self.site);
+        }
+    }
+
     /// Time left (zero once passed).
     pub fn remaining(&self) -> Duration {
         self.at.saturating_sub(self.clock.now())

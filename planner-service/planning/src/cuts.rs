@@ -275,6 +275,12 @@ impl CutLog {
         }
     }
 
+    /// Forgets the cuts taken at `site` (work whose result is not used: a replay need not
+    /// run it).
+    pub(crate) fn forget(&self, site: Site) {
+        self.lock().taken.retain(|c| c.site != site);
+    }
+
     fn lock_taken(&self, cut: Cut) {
         self.lock().taken.push(cut);
     }

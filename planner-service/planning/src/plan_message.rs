@@ -178,18 +178,30 @@ pub fn set_next_replan(plan: &mut Plan, t_r: Option<f64>) {
 }
 
 /// Writes the plan's deadline cuts (sorted, as `CutLog::finish` gives them); the number
-/// that did not fit (a replay of the plan then cannot take its course).
+/// that did not fit. Then the last entry is [`TRUNCATED_CUTS`] with that number as its
+/// step, and a replay of the plan refuses it.
 pub fn set_cuts(plan: &mut Plan, cuts: &[Cut]) -> usize {
-    let kept = cuts.len().min(MAX_PLAN_CUTS);
+    let fits = cuts.len() <= MAX_PLAN_CUTS;
+    let kept = if fits { cuts.len() } else { MAX_PLAN_CUTS - 1 };
     for (slot, cut) in plan.cuts.iter_mut().zip(&cuts[..kept]) {
         *slot = PlanCut {
             site: cut.site.code(),
             step: cut.step,
         };
     }
-    plan.cut_count = kept as u32;
-    cuts.len() - kept
+    let dropped = cuts.len() - kept;
+    if !fits {
+        plan.cuts[kept] = PlanCut {
+            site: TRUNCATED_CUTS,
+            step: dropped as u32,
+        };
+    }
+    plan.cut_count = (kept + usize::from(!fits)) as u32;
+    dropped
 }
+
+/// The site code of the last cut of a plan whose cuts did not all fit in its message.
+pub const TRUNCATED_CUTS: u32 = u32::MAX;
 
 /// The deadline cuts a plan carries, for a replay (an unknown site code is an error: the
 /// plan was made by another version of the planner).

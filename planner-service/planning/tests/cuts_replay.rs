@@ -108,3 +108,34 @@ fn a_warm_re_plan_cut_short_replays_byte_for_byte() {
         assert_same_plan(name, &a, &b, &recorded, &taken);
     }
 }
+
+/// A plan's cuts survive the `Plan` message; more than it holds are marked, and refused.
+#[test]
+fn cuts_travel_in_the_plan_message_and_an_overflow_is_marked() {
+    use wingman_interfaces::{MAX_PLAN_CUTS, Plan, Wire};
+    use wingman_planning::cuts::{Part, Site, Work};
+    use wingman_planning::plan_message::{TRUNCATED_CUTS, cuts_of, set_cuts};
+
+    let cut = |i: u16, step: u32| Cut {
+        site: Site {
+            part: Part::Global,
+            work: Work::Rank(i),
+        },
+        step,
+    };
+    let mut plan = Plan::zeroed();
+    let few: Vec<Cut> = (0..3).map(|i| cut(i, 7 + u32::from(i))).collect();
+    assert_eq!(set_cuts(&mut plan, &few), 0);
+    assert_eq!(cuts_of(&plan), Ok(few));
+
+    let many: Vec<Cut> = (0..MAX_PLAN_CUTS as u16 + 5).map(|i| cut(i, 1)).collect();
+    assert_eq!(
+        set_cuts(&mut plan, &many),
+        6,
+        "the last slot marks the overflow"
+    );
+    assert_eq!(plan.cut_count as usize, MAX_PLAN_CUTS);
+    assert_eq!(plan.cuts[MAX_PLAN_CUTS - 1].site, TRUNCATED_CUTS);
+    assert_eq!(plan.cuts[MAX_PLAN_CUTS - 1].step, 6);
+    assert_eq!(cuts_of(&plan), Err(TRUNCATED_CUTS));
+}

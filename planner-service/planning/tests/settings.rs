@@ -59,6 +59,32 @@ fn an_extra_option_the_solver_does_not_know_is_refused_at_validation() {
     ));
 }
 
+/// The solver's own time budgets are refused: when a solve stops is the planner's deadline's
+/// choice, recorded as a deadline cut so that a replay takes it again.
+#[test]
+fn an_extra_option_that_spends_the_solvers_own_time_is_refused() {
+    for name in [
+        "max_wall_time",
+        "max_cpu_time",
+        "adaptive_mu_budget_pin_fraction",
+        "crossover",
+    ] {
+        let bad = NlpSettings::default().with_extra(name, "1");
+        assert!(
+            matches!(
+                bad.validate(),
+                Err(NlpSettingsError::OutOfRange {
+                    setting: "extra",
+                    ..
+                })
+            ),
+            "{name}"
+        );
+    }
+    let fine = NlpSettings::default().with_extra("max_soc", "2");
+    assert_eq!(fine.validate(), Ok(()));
+}
+
 #[test]
 fn a_plan_with_bad_settings_fails_before_it_starts() {
     let sc = bundled("2d-min-time-avoidable").unwrap().unwrap();

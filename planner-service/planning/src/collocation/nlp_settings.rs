@@ -7,6 +7,16 @@ use pounce_rs::IpoptApplication;
 use super::kkt::KktSolver;
 use super::solve::set_extra_options;
 
+/// Solver options that spend the solver's own time budget (the OS clock): refused as extra
+/// options, since the planner's deadline and its recorded cuts decide when a solve stops.
+const CLOCK_OPTIONS: [&str; 5] = [
+    "max_wall_time",
+    "max_cpu_time",
+    "adaptive_mu_budget_pin_fraction",
+    "crossover",
+    "ipm_sqp_handover",
+];
+
 /// Settings of the NLP solve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NlpSettings {
@@ -236,6 +246,18 @@ impl NlpSettings {
         }
         if !(0..=12).contains(&self.print_level) {
             return out("print_level", "must be in 0..=12");
+        }
+        if self
+            .extra
+            .iter()
+            .any(|(name, _)| CLOCK_OPTIONS.contains(&name.as_str()))
+        {
+            return out(
+                "extra",
+                "max_wall_time, max_cpu_time, adaptive_mu_budget_pin_fraction, crossover and \
+                 ipm_sqp_handover spend the solver's own time budget: choices of the clock \
+                 that no deadline cut records (the deadline is the planner's)",
+            );
         }
         if !self.extra.is_empty() {
             let mut app = IpoptApplication::new();

@@ -342,6 +342,10 @@ fn application(
     // end after the budget in real time, on a loaded host unfinished. It stays as a
     // backstop only, past anything the callback lets through.
     num(o, "max_wall_time", (budget * 2).as_secs_f64() + 1.0)?;
+    // Nothing else in the solver may spend a share of that wall time: the adaptive
+    // barrier's switch to its monotone endgame would be a choice of the clock that no
+    // deadline cut records (`crate::cuts`), so a replay would not take it.
+    num(o, "adaptive_mu_budget_pin_fraction", 1.0)?;
     let int = |o: &mut OptionsList, name: &'static str, v: i32| {
         o.set_integer_value(name, v, true, false)
             .map(|_| ())
@@ -521,8 +525,10 @@ pub fn solve(
         ApplicationReturnStatus::MaximumWallTimeExceeded
             | ApplicationReturnStatus::MaximumCpuTimeExceeded
     ) {
-        // The backstop stopped it after this callback: a replay stops it there.
-        deadline.note_cut(a.callbacks);
+        // The backstop stopped it after this callback: a replay stops it there (one
+        // stopped before its first callback, after a set-up of over a second past its
+        // deadline, is replayed as stopped at its first: step 0 means "not started").
+        deadline.note_cut(a.callbacks.max(1));
     }
     let status = match return_status {
         ApplicationReturnStatus::SolveSucceeded

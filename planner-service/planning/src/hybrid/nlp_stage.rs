@@ -402,6 +402,18 @@ impl schedule::Stage for NlpStage<'_> {
         self.deadline.expired()
     }
 
+    fn discard(&self, c: usize, round: bool) {
+        let work = if round {
+            Work::Round {
+                candidate: c as u8,
+                round: 0,
+            }
+        } else {
+            Work::Final(c as u16)
+        };
+        self.deadline.at(work).forget_cuts();
+    }
+
     fn round_cut(&self, started: bool) -> bool {
         let deadline = self.deadline.at(Work::WinnerRound);
         deadline.cuts(0, |d| !started && d.expired())

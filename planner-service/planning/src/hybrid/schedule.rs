@@ -51,6 +51,10 @@ pub(super) trait Stage: Sync {
     /// Whether the deadline cuts the winner's first round (`started`: it is already
     /// running, speculatively), recorded as a deadline cut (`crate::cuts`).
     fn round_cut(&self, started: bool) -> bool;
+    /// Candidate `c`'s final (`round`: its first round) ran speculatively, or not at all,
+    /// and its result is not used: the deadline cuts it took are forgotten, since a replay
+    /// need not run it.
+    fn discard(&self, c: usize, round: bool);
     /// The stage clock's time.
     fn now(&self) -> Duration;
 }
@@ -344,6 +348,14 @@ pub(super) fn run<S: Stage>(stage: &S, threads: usize) -> Schedule<S> {
     } = shared;
     let board = board.into_inner().unwrap_or_else(|e| e.into_inner());
     let chosen = board.chosen.unwrap_or_default();
+    for c in 0..candidates {
+        if !chosen.contains(&c) {
+            stage.discard(c, false);
+        }
+        if board.wanted_round != Some(c) {
+            stage.discard(c, true);
+        }
+    }
     let mut finals: Vec<Option<S::Final>> = finals.into_iter().map(OnceLock::into_inner).collect();
     let mut rounds: Vec<Option<S::Round>> = rounds.into_iter().map(OnceLock::into_inner).collect();
     Schedule {
@@ -466,6 +478,8 @@ mod tests {
         fn round_cut(&self, started: bool) -> bool {
             !started && self.expired()
         }
+
+        fn discard(&self, _c: usize, _round: bool) {}
 
         fn now(&self) -> Duration {
             self.clock.elapsed()

@@ -180,8 +180,9 @@ impl PlannerSettings {
         if !fraction(self.swarm_share) {
             return out("swarm_share", "must be in (0, 1]");
         }
-        if self.starts == 0 {
-            return out("starts", "must be at least 1");
+        if !(1..=200).contains(&self.starts) {
+            // A start's index names its solves' deadline cuts in 8 bits (`cuts::Work`).
+            return out("starts", "must be in 1..=200");
         }
         if !(1..=64).contains(&self.threads) {
             return out("threads", "must be in 1..=64");
