@@ -7,7 +7,7 @@
 use std::time::Duration;
 
 use wingman_planning::clock::Deadline;
-use wingman_planning::cuts::{Cut, CutLog};
+use wingman_planning::cuts::{Cut, CutLog, Part, Site, Work};
 use wingman_planning::hybrid::{FlyingPlan, PlanOutcome, Planner, PlannerSettings};
 use wingman_planning::problem::{Problem, Threats};
 use wingman_planning::threat::Superquadric;
@@ -79,26 +79,7 @@ fn a_warm_re_plan_cut_short_replays_byte_for_byte() {
     ] {
         let (take_off, path) = planned(name);
         let flying = FlyingPlan::new(&take_off, path);
-        let tf = flying.path.final_time().unwrap();
-        let mut p = take_off.clone();
-        p.t0 = take_off.t0 + 0.2 * (tf - take_off.t0);
-        p.x0 = flying.path.at(p.t0).unwrap().0;
-        // A pop-up on the path ahead: the warm path ranks its bends (and seeds in 2-D).
-        let (ahead, _) = flying.path.at(p.t0 + 0.3 * (tf - p.t0)).unwrap();
-        match &mut p.threats {
-            Threats::Planar { layout, .. } => layout
-                .push(Superquadric::ellipsoid([ahead[0], ahead[1]], [4000.0, 4000.0]).unwrap())
-                .unwrap(),
-            Threats::Spatial { layout, .. } => layout
-                .push(
-                    Superquadric::ellipsoid(
-                        [ahead[0], ahead[1], ahead[2]],
-                        [4000.0, 4000.0, 3000.0],
-                    )
-                    .unwrap(),
-                )
-                .unwrap(),
-        }
+        let p = popup_ahead(&take_off, &flying);
         let budget = Duration::from_millis(budget_ms);
         let (a, b, recorded, taken) = cut_and_replayed(&p, Some(&flying), budget);
         assert!(
@@ -109,11 +90,32 @@ fn a_warm_re_plan_cut_short_replays_byte_for_byte() {
     }
 }
 
+/// The re-plan problem at 20 % of `flying` with a pop-up on its path ahead (the warm path
+/// ranks its bends, and seeds in 2-D).
+fn popup_ahead(take_off: &Problem, flying: &FlyingPlan) -> Problem {
+    let tf = flying.path.final_time().unwrap();
+    let mut p = take_off.clone();
+    p.t0 = take_off.t0 + 0.2 * (tf - take_off.t0);
+    p.x0 = flying.path.at(p.t0).unwrap().0;
+    let (ahead, _) = flying.path.at(p.t0 + 0.3 * (tf - p.t0)).unwrap();
+    match &mut p.threats {
+        Threats::Planar { layout, .. } => layout
+            .push(Superquadric::ellipsoid([ahead[0], ahead[1]], [4000.0, 4000.0]).unwrap())
+            .unwrap(),
+        Threats::Spatial { layout, .. } => layout
+            .push(
+                Superquadric::ellipsoid([ahead[0], ahead[1], ahead[2]], [4000.0, 4000.0, 3000.0])
+                    .unwrap(),
+            )
+            .unwrap(),
+    }
+    p
+}
+
 /// A plan's cuts survive the `Plan` message; more than it holds are marked, and refused.
 #[test]
 fn cuts_travel_in_the_plan_message_and_an_overflow_is_marked() {
     use wingman_interfaces::{MAX_PLAN_CUTS, Plan, Wire};
-    use wingman_planning::cuts::{Part, Site, Work};
     use wingman_planning::plan_message::{TRUNCATED_CUTS, cuts_of, set_cuts};
 
     let cut = |i: u16, step: u32| Cut {
