@@ -20,8 +20,10 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicIsize, Ordering};
 use std::time::Duration;
 
+use wingman_interfaces::Quality;
 use wingman_planning::clock::{Clock, Deadline, MonotonicClock};
 use wingman_planning::collocation::kkt::KktCache;
+use wingman_planning::cuts::{CutList, CutLog};
 use wingman_planning::hybrid::{Planner, PlannerSettings};
 use wingman_planning::problem::Problem;
 use wingman_planning::scenario::{BUNDLED, bundled};
@@ -214,6 +216,8 @@ fn main() {
     // Short budgets: the quality a budget too short for the whole NLP stage gives (the
     // floor, `Feasible`, or the swarm's path), and how far past its deadline the planner
     // returns.
+    let cut_log: &'static CutLog = Box::leak(Box::new(CutLog::new()));
+    let mut swarm_only = Vec::new();
     println!("\n| scenario | budget ms | returned after ms (median / max of {runs}) | qualities |");
     println!("|---|---:|---:|---|");
     for (name, problem) in &scenarios {
@@ -231,15 +235,24 @@ fn main() {
             for seed in 1..=runs {
                 let s = settings_of(seed);
                 let began = clock.now();
+                cut_log.begin(None);
+                let deadline = Deadline::after(clock, Duration::from_millis(budget_ms));
                 let out = planner
-                    .plan(
-                        problem,
-                        &s,
-                        Deadline::after(clock, Duration::from_millis(budget_ms)),
-                    )
+                    .plan(problem, &s, deadline.with_cuts(cut_log))
                     .unwrap();
                 over.push((clock.now() - began).as_secs_f64() * 1e3);
                 *qualities.entry(format!("{:?}", out.quality)).or_insert(0) += 1;
+                let cuts = cut_log.finish();
+                if out.quality == Quality::SwarmOnly && budget_ms == floor_budget(problem.dim()) {
+                    swarm_only.push(format!(
+                        "{name} seed {seed} at {budget_ms} ms: swarm {:.1} ms, nlp {:.1} ms, \
+                         iterations {:?}; cuts {}",
+                        out.times.swarm.as_secs_f64() * 1e3,
+                        out.times.nlp.as_secs_f64() * 1e3,
+                        out.nlp.iterations,
+                        CutList(&cuts)
+                    ));
+                }
             }
             over.sort_by(f64::total_cmp);
             let qualities: Vec<String> =
@@ -252,4 +265,14 @@ fn main() {
             );
         }
     }
+    println!("\nSwarmOnly at the floor's budget (50 ms in 2-D, 150 ms in 3-D):");
+    for line in &swarm_only {
+        println!("- {line}");
+    }
+}
+
+/// The budget at which a cold plan must not come back `SwarmOnly` (issue 31): 50 ms in
+/// 2-D, 150 ms in 3-D.
+fn floor_budget(dim: usize) -> u64 {
+    if dim == 3 { 150 } else { 50 }
 }
