@@ -14,7 +14,7 @@
 
 pub mod layout;
 
-mod doc;
+pub mod doc;
 mod header;
 mod kinds;
 mod lead;

@@ -4,6 +4,8 @@
 //! - this module: the iceoryx2 services, their quality of service, the wake event ids, the
 //!   port helpers and the dead-node clean-up;
 //! - [`client`]: a client's side of a vehicle's services (the harness's, the tests');
+//! - [`contract`]: the services' settings and wake ids for other languages, generated
+//!   into `docs/INTERFACES.md` and `docs/contract.json`;
 //! - [`config`]: the planner's configuration file, `planner.toml` (the harness writes one
 //!   for every planner it starts);
 //! - [`logging`]: the log set-up of both binaries.
@@ -27,6 +29,7 @@
 
 pub mod client;
 pub mod config;
+pub mod contract;
 pub mod logging;
 
 pub use client::{ClientPorts, InputPublishers};
