@@ -1,8 +1,9 @@
 //! The run-time contract for clients in any language, generated from the code: every
 //! service's settings that iceoryx2 checks when a second process opens it, the wake event
 //! ids, and — with the message layouts, enums and constants of `wingman-interfaces` — the
-//! same contract as JSON for code generators (`docs/contract.json`). A test keeps
-//! `docs/INTERFACES.md`'s services part and `docs/contract.json` equal to this output.
+//! same contract as JSON for code generators (`docs/contract.json`) and as a C header
+//! (`clients/c/wingman.h`). A test keeps `docs/INTERFACES.md`'s services part, the JSON
+//! and the header equal to this output, and compiles the header.
 
 use core::fmt::Write;
 
@@ -180,4 +181,132 @@ pub fn contract_json() -> Value {
         "structs": doc::structs().iter().map(wire_json).collect::<Vec<_>>(),
         "enums": doc::enums().iter().map(enum_json).collect::<Vec<_>>(),
     })
+}
+
+/// `Model::TwoD` → `TWO_D`: a variant's name as a C constant's suffix.
+fn upper_snake(name: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in name.chars().enumerate() {
+        if c.is_ascii_uppercase() && i > 0 {
+            out.push('_');
+        }
+        out.push(c.to_ascii_uppercase());
+    }
+    out
+}
+
+fn c_scalar(element: Element) -> String {
+    match element {
+        Element::Scalar(s) => match s.name() {
+            "f64" => "double".into(),
+            "i64" => "int64_t".into(),
+            "u64" => "uint64_t".into(),
+            "u32" => "uint32_t".into(),
+            _ => "uint8_t".into(),
+        },
+        Element::Struct { name, .. } => format!("wingman_{name}"),
+    }
+}
+
+fn c_struct(out: &mut String, t: &WireType) {
+    let name = format!("wingman_{}", t.name);
+    let _ = writeln!(out, "/* {} */", one_line(t.doc));
+    let _ = writeln!(out, "typedef struct {name} {{");
+    for f in t.fields {
+        let dims: String = (f.dims)().iter().map(|d| format!("[{d}]")).collect();
+        let unit = if f.unit == "-" {
+            String::new()
+        } else {
+            format!(" [{}]", f.unit)
+        };
+        let _ = writeln!(
+            out,
+            "    {} {}{dims}; /* {}{unit} */",
+            c_scalar(f.element),
+            f.name,
+            one_line(f.doc).replace("*/", "* /")
+        );
+    }
+    let _ = writeln!(out, "}} {name};");
+    let _ = writeln!(
+        out,
+        "WINGMAN_STATIC_ASSERT(sizeof({name}) == {}, \"size of {name}\");",
+        t.size
+    );
+    let _ = writeln!(
+        out,
+        "WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF({name}) == {}, \"alignment of {name}\");",
+        t.align
+    );
+    for f in t.fields {
+        let _ = writeln!(
+            out,
+            "WINGMAN_STATIC_ASSERT(offsetof({name}, {}) == {}, \"offset of {name}.{}\");",
+            f.name, f.offset, f.name
+        );
+    }
+    out.push('\n');
+}
+
+/// The C header of the contract (`clients/c/wingman.h`): constants, wake ids, enum values,
+/// service name suffixes and every wire struct, with a static assertion of every size,
+/// alignment and offset. C11 or C++11.
+pub fn c_header() -> String {
+    let mut out = String::new();
+    let _ = write!(
+        out,
+        "/* wingman.h: the wingman planner's message contract for C and C++ (protocol {}).\n\
+         \x20* Generated from the Rust code (`WINGMAN_BLESS=1 cargo test -p wingman-ipc --test\n\
+         \x20* contract`); do not edit. Layouts are little-endian, `#[repr(C)]`, with no implicit\n\
+         \x20* padding; docs/INTERFACES.md says what each field means. */\n\
+         #ifndef WINGMAN_H\n#define WINGMAN_H\n\n\
+         #include <stddef.h>\n#include <stdint.h>\n\n\
+         #ifdef __cplusplus\n\
+         #define WINGMAN_STATIC_ASSERT(c, m) static_assert(c, m)\n\
+         #define WINGMAN_ALIGNOF(t) alignof(t)\n\
+         #else\n\
+         #define WINGMAN_STATIC_ASSERT(c, m) _Static_assert(c, m)\n\
+         #define WINGMAN_ALIGNOF(t) _Alignof(t)\n\
+         #endif\n\n",
+        wingman_interfaces::PROTOCOL_VERSION
+    );
+    out.push_str("/* Constants */\n");
+    for (name, value) in doc::constants() {
+        let _ = writeln!(out, "#define WINGMAN_{name} {value}");
+    }
+    out.push_str("\n/* Wake event ids */\n");
+    for (name, id, meaning) in wake_events() {
+        let meaning = meaning.replace('`', "");
+        let _ = writeln!(out, "#define WINGMAN_{name} {id} /* {meaning} */");
+    }
+    out.push_str("\n/* Service names: \"wingman/\" <vehicle id> \"/\" suffix */\n");
+    for s in Service::ALL {
+        let _ = writeln!(
+            out,
+            "#define WINGMAN_SERVICE_{} \"{}\"",
+            upper_snake(&format!("{s:?}")),
+            s.suffix()
+        );
+    }
+    out.push_str("\n/* Enum values (u32 fields) */\n");
+    for e in doc::enums() {
+        for (name, value, _) in e.variants {
+            let _ = writeln!(
+                out,
+                "#define WINGMAN_{}_{} {value}",
+                upper_snake(e.name),
+                upper_snake(name)
+            );
+        }
+    }
+    out.push_str("\n/* Structs inside messages */\n\n");
+    for t in doc::structs() {
+        c_struct(&mut out, &t);
+    }
+    out.push_str("/* Messages */\n\n");
+    for t in doc::messages() {
+        c_struct(&mut out, &t);
+    }
+    out.push_str("#endif /* WINGMAN_H */\n");
+    out
 }

@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 
 use wingman_interfaces::Service;
-use wingman_ipc::contract::{contract_json, services_markdown};
+use wingman_ipc::contract::{c_header, contract_json, services_markdown};
 use wingman_ipc::qos;
 
 const BEGIN: &str = "<!-- BEGIN GENERATED: cargo test -p wingman-ipc --test contract (WINGMAN_BLESS=1 rewrites) -->";
@@ -111,4 +111,76 @@ fn the_json_contract_holds_each_services_settings_and_each_fields_offset() {
     );
     let events = c["wake_events"].as_array().unwrap();
     assert_eq!(events[0]["id"], wingman_ipc::WAKE_INPUT.as_value());
+}
+
+fn header_path() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../clients/c/wingman.h")
+}
+
+#[test]
+fn the_c_header_is_the_codes() {
+    let path = header_path();
+    let generated = c_header();
+    if bless() {
+        std::fs::create_dir_all(path.parent().unwrap()).expect("clients/c");
+        std::fs::write(&path, &generated).expect("write clients/c/wingman.h");
+        return;
+    }
+    let text = std::fs::read_to_string(&path).expect("clients/c/wingman.h");
+    assert!(
+        text == generated,
+        "clients/c/wingman.h is out of date; run WINGMAN_BLESS=1 cargo test -p wingman-ipc \
+         --test contract and review the diff"
+    );
+}
+
+/// Compiles a file that includes the header with `compiler` and `args`; the header's static
+/// assertions (every size, alignment and offset of the Rust types) must hold, warnings are
+/// errors. `false` if the compiler is not installed.
+fn compiles(compiler: &str, args: &[&str], source: &str, ext: &str) -> bool {
+    let dir = std::env::temp_dir().join(format!("wingman-header-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join(format!("uses_header.{ext}"));
+    std::fs::write(&file, source).unwrap();
+    let include = header_path().parent().unwrap().to_path_buf();
+    let out = match std::process::Command::new(compiler)
+        .args(args)
+        .arg("-I")
+        .arg(&include)
+        .arg("-fsyntax-only")
+        .arg(&file)
+        .output()
+    {
+        Ok(o) => o,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return false,
+        Err(e) => panic!("{compiler}: {e}"),
+    };
+    assert!(
+        out.status.success(),
+        "{compiler} rejects clients/c/wingman.h:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    true
+}
+
+#[test]
+fn the_c_header_compiles_and_its_layout_assertions_hold() {
+    let source = "#include \"wingman.h\"\n\
+                  int main(void) {\n\
+                  \x20   wingman_Plan *plan = 0;\n\
+                  \x20   (void)plan;\n\
+                  \x20   return WINGMAN_PROTOCOL_VERSION == 0;\n\
+                  }\n";
+    let c_args = ["-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic"];
+    assert!(
+        compiles("cc", &c_args, source, "c"),
+        "no C compiler (`cc`): CI installs one (.ci/run)"
+    );
+    // C++ too, where a compiler is installed.
+    let _ = compiles(
+        "c++",
+        &["-std=c++11", "-Wall", "-Wextra", "-Werror"],
+        source,
+        "cpp",
+    );
 }
