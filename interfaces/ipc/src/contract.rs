@@ -1,8 +1,8 @@
 //! The run-time contract for clients in any language, generated from the code: every
 //! service's settings that iceoryx2 checks when a second process opens it, the wake event
 //! ids, and — with the message layouts, enums and constants of `wingman-interfaces` — the
-//! same contract as JSON for code generators (`docs/contract.json`) and as a C header
-//! (`clients/c/wingman.h`). A test keeps `docs/INTERFACES.md`'s services part, the JSON
+//! same contract as JSON for code generators (`docs/contract.json`), as a C header
+//! (`clients/c/wingman.h`) and as Python `ctypes` (`clients/python/wingman_client/contract.py`). A test keeps `docs/INTERFACES.md`'s services part, the JSON
 //! and the header equal to this output, and compiles the header.
 
 use core::fmt::Write;
@@ -308,5 +308,112 @@ pub fn c_header() -> String {
         c_struct(&mut out, &t);
     }
     out.push_str("#endif /* WINGMAN_H */\n");
+    out
+}
+
+fn py_type(f: &FieldInfo) -> String {
+    let base = match f.element {
+        Element::Scalar(s) => match s.name() {
+            "f64" => "ctypes.c_double".to_string(),
+            "i64" => "ctypes.c_int64".into(),
+            "u64" => "ctypes.c_uint64".into(),
+            "u32" => "ctypes.c_uint32".into(),
+            _ => "ctypes.c_uint8".into(),
+        },
+        Element::Struct { name, .. } => name.to_string(),
+    };
+    // C order: the last dimension is the innermost array.
+    (f.dims)()
+        .iter()
+        .rev()
+        .fold(base, |inner, d| format!("({inner} * {d})"))
+}
+
+fn py_struct(out: &mut String, t: &WireType) {
+    let _ = writeln!(out, "\nclass {}(ctypes.Structure):", t.name);
+    let _ = writeln!(
+        out,
+        "    \"\"\"{}\"\"\"\n",
+        one_line(t.doc).replace('\\', "\\\\")
+    );
+    out.push_str("    _fields_ = [\n");
+    for f in t.fields {
+        let _ = writeln!(out, "        (\"{}\", {}),", f.name, py_type(f));
+    }
+    out.push_str("    ]\n\n");
+    let _ = writeln!(out, "    SIZE = {}", t.size);
+    let _ = writeln!(out, "    ALIGN = {}", t.align);
+    out.push_str("\n    @staticmethod\n    def type_name() -> str:\n");
+    let _ = writeln!(out, "        return \"{}\"", t.type_name);
+}
+
+/// The Python module of the contract (`clients/python/wingman_client/contract.py`): the
+/// constants, wake ids, service suffixes and settings, enum values, and every wire struct
+/// as a `ctypes.Structure` with the iceoryx2 type name the Rust side gives it.
+pub fn python_module() -> String {
+    let mut out = String::new();
+    let _ = write!(
+        out,
+        "\"\"\"The wingman planner's message contract (protocol {}), as Python ctypes.\n\n\
+         Generated from the Rust code (`WINGMAN_BLESS=1 cargo test -p wingman-ipc --test contract`);\n\
+         do not edit. Layouts are little-endian and `repr(C)` with no implicit padding;\n\
+         docs/INTERFACES.md says what each field means.\n\
+         \"\"\"\n\n\
+         import ctypes\n\n",
+        wingman_interfaces::PROTOCOL_VERSION
+    );
+    for (name, value) in doc::constants() {
+        let _ = writeln!(out, "{name} = {value}");
+    }
+    out.push('\n');
+    for (name, id, meaning) in wake_events() {
+        let _ = writeln!(out, "{name} = {id}  # {}", meaning.replace('`', ""));
+    }
+    out.push_str(
+        "\n# Service name suffixes: \"wingman/\" + vehicle id + \"/\" + suffix.\nSERVICES = {\n",
+    );
+    for s in Service::ALL {
+        let _ = writeln!(out, "    \"{s:?}\": \"{}\",", s.suffix());
+    }
+    out.push_str(
+        "}\n\n# The settings iceoryx2 compares when a second process opens a service.\nSETTINGS = {\n",
+    );
+    for s in Service::ALL {
+        let q = qos(s);
+        let _ = writeln!(
+            out,
+            "    \"{s:?}\": {{\"history_size\": {}, \"subscriber_max_buffer_size\": {}, \
+             \"max_publishers\": {}, \"max_subscribers\": {}, \"max_nodes\": {}}},",
+            q.history_size, q.subscriber_buffer, q.max_publishers, q.max_subscribers, q.max_nodes
+        );
+    }
+    out.push_str("}\n");
+    for e in doc::enums() {
+        let _ = writeln!(out, "\n# {}: {}", e.name, one_line(e.doc));
+        for (name, value, _) in e.variants {
+            let _ = writeln!(
+                out,
+                "{}_{} = {value}",
+                upper_snake(e.name),
+                upper_snake(name)
+            );
+        }
+    }
+    out.push('\n');
+    for t in doc::structs() {
+        py_struct(&mut out, &t);
+        out.push('\n');
+    }
+    for t in doc::messages() {
+        py_struct(&mut out, &t);
+        out.push('\n');
+    }
+    out.push_str("\nMESSAGES = {\n");
+    for s in Service::ALL {
+        if let Some(p) = doc::payload(s) {
+            let _ = writeln!(out, "    \"{s:?}\": {p},");
+        }
+    }
+    out.push_str("}\n");
     out
 }

@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 
 use wingman_interfaces::Service;
-use wingman_ipc::contract::{c_header, contract_json, services_markdown};
+use wingman_ipc::contract::{c_header, contract_json, python_module, services_markdown};
 use wingman_ipc::qos;
 
 const BEGIN: &str = "<!-- BEGIN GENERATED: cargo test -p wingman-ipc --test contract (WINGMAN_BLESS=1 rewrites) -->";
@@ -45,18 +45,8 @@ fn the_documents_service_settings_are_the_codes() {
 
 #[test]
 fn the_json_contract_is_the_codes() {
-    let path = docs().join("contract.json");
     let generated = serde_json::to_string_pretty(&contract_json()).unwrap() + "\n";
-    if bless() {
-        std::fs::write(&path, &generated).expect("write docs/contract.json");
-        return;
-    }
-    let text = std::fs::read_to_string(&path).expect("docs/contract.json");
-    assert!(
-        text == generated,
-        "docs/contract.json is out of date; run WINGMAN_BLESS=1 cargo test -p wingman-ipc \
-         --test contract and review the diff"
-    );
+    generated_file(&docs().join("contract.json"), &generated);
 }
 
 /// The JSON says what a generator needs, independently checked against the Rust types: a
@@ -117,21 +107,25 @@ fn header_path() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../clients/c/wingman.h")
 }
 
-#[test]
-fn the_c_header_is_the_codes() {
-    let path = header_path();
-    let generated = c_header();
+/// `path` holds `generated` (blessing: is rewritten with it).
+fn generated_file(path: &std::path::Path, generated: &str) {
+    let shown = path.display();
     if bless() {
-        std::fs::create_dir_all(path.parent().unwrap()).expect("clients/c");
-        std::fs::write(&path, &generated).expect("write clients/c/wingman.h");
+        std::fs::create_dir_all(path.parent().unwrap()).expect("the file's folder");
+        std::fs::write(path, generated).unwrap_or_else(|e| panic!("write {shown}: {e}"));
         return;
     }
-    let text = std::fs::read_to_string(&path).expect("clients/c/wingman.h");
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{shown}: {e}"));
     assert!(
         text == generated,
-        "clients/c/wingman.h is out of date; run WINGMAN_BLESS=1 cargo test -p wingman-ipc \
-         --test contract and review the diff"
+        "{shown} is out of date; run WINGMAN_BLESS=1 cargo test -p wingman-ipc --test \
+         contract and review the diff"
     );
+}
+
+#[test]
+fn the_c_header_is_the_codes() {
+    generated_file(&header_path(), &c_header());
 }
 
 /// Compiles a file that includes the header with `compiler` and `args`; the header's static
@@ -183,4 +177,50 @@ fn the_c_header_compiles_and_its_layout_assertions_hold() {
         source,
         "cpp",
     );
+}
+
+fn python_path() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../clients/python/wingman_client/contract.py")
+}
+
+#[test]
+fn the_python_module_is_the_codes() {
+    generated_file(&python_path(), &python_module());
+}
+
+/// Python's own `ctypes` lays the generated structs out as the Rust types are: every size,
+/// alignment and field offset of `docs/contract.json`, checked by `python3`.
+#[test]
+fn python_lays_the_structs_out_as_rust_does() {
+    let check = r#"
+import ctypes, json, sys
+sys.path.insert(0, sys.argv[1])
+import contract as c
+doc = json.load(open(sys.argv[2]))
+n = 0
+for t in doc["structs"] + doc["messages"]:
+    cls = getattr(c, t["name"])
+    assert ctypes.sizeof(cls) == t["size"], (t["name"], ctypes.sizeof(cls), t["size"])
+    assert ctypes.alignment(cls) == t["align"], (t["name"], ctypes.alignment(cls))
+    assert cls.type_name() == t["type_name"], t["name"]
+    for f in t["fields"]:
+        assert getattr(cls, f["name"]).offset == f["offset"], (t["name"], f["name"])
+        n += 1
+print(n)
+"#;
+    let out = std::process::Command::new("python3")
+        .arg("-c")
+        .arg(check)
+        .arg(python_path().parent().unwrap())
+        .arg(docs().join("contract.json"))
+        .output()
+        .expect("python3");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let fields: usize = String::from_utf8_lossy(&out.stdout).trim().parse().unwrap();
+    assert!(fields > 100, "{fields} fields checked");
 }

@@ -7,6 +7,7 @@
 use std::time::{Duration, Instant};
 
 use iceoryx2::node::Node;
+use iceoryx2::port::listener::ListenerWaitError;
 use wingman_interfaces::*;
 use wingman_ipc::{self as ipc, ClientPorts, Ipc, ServiceConfig};
 
@@ -174,11 +175,16 @@ impl FakeHarness {
             if start.elapsed() > timeout {
                 return false;
             }
-            let _ = self
+            // A signal (a child planner killed by the test) interrupts the wait: a spurious
+            // wake-up, as any other.
+            match self
                 .ports
                 .listener
                 .timed_wait(|_| {}, Duration::from_millis(50))
-                .unwrap();
+            {
+                Ok(_) | Err(ListenerWaitError::InterruptSignal) => {}
+                Err(e) => panic!("waiting on wake/harness: {e:?}"),
+            }
         }
     }
 

@@ -12,42 +12,15 @@ pub fn judge_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/judge")
 }
 
-fn has_numpy(python: &Path) -> bool {
-    Command::new(python)
-        .args(["-c", "import numpy, scipy"])
-        .output()
-        .is_ok_and(|o| o.status.success())
-}
-
 /// A Python interpreter with numpy and scipy (set up on first use).
 pub fn python() -> &'static PathBuf {
     static PYTHON: OnceLock<PathBuf> = OnceLock::new();
     PYTHON.get_or_init(|| {
-        let system = PathBuf::from("python3");
-        if has_numpy(&system) {
-            return system;
-        }
-        let venv = crate::target_dir().join("judge-venv");
-        let python = venv.join("bin/python3");
-        if !has_numpy(&python) {
-            let ok = Command::new("python3")
-                .args(["-m", "venv"])
-                .arg(&venv)
-                .status()
-                .is_ok_and(|s| s.success());
-            assert!(
-                ok,
-                "python3 -m venv {} failed: the judge needs Python 3 with venv",
-                venv.display()
-            );
-            let ok = Command::new(&python)
-                .args(["-m", "pip", "install", "--quiet", "-r"])
-                .arg(judge_dir().join("requirements.txt"))
-                .status()
-                .is_ok_and(|s| s.success());
-            assert!(ok, "installing numpy and scipy for the judge failed");
-        }
-        python
+        crate::python::python_with(
+            "numpy, scipy",
+            &judge_dir().join("requirements.txt"),
+            "judge-venv",
+        )
     })
 }
 

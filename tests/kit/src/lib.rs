@@ -18,6 +18,7 @@ pub mod counting_alloc;
 pub mod fake_harness;
 pub mod judge;
 pub mod process;
+pub mod python;
 pub mod random_scenario;
 pub mod rogue;
 
