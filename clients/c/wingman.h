@@ -80,13 +80,17 @@
 
 /* Structs inside messages */
 
-/* Starts every message. `sequence` grows by one per message on each service; `mission_time_ns` is the sender's mission clock when it published. */
+/* Starts every message. A sender's `sequence` grows by one per message it publishes, one counter across all its services (so that the planner's status can echo the last input it processed); `mission_time_ns` is the sender's mission clock when it published. */
 typedef struct wingman_Header {
     uint32_t protocol_version; /* `PROTOCOL_VERSION` of the sender. */
     uint32_t sender_id; /* Who sent it: 1 planner, 2 harness, other values for test tools. */
-    uint64_t sequence; /* Per-service message counter of the sender, starting at 1. */
+    uint64_t sequence; /* The sender's message counter, one across all its services, starting at 1. */
     int64_t mission_time_ns; /* Mission time at publication. [ns] */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::Header";
+#endif
 } wingman_Header;
+#define WINGMAN_HEADER_TYPE_NAME "wingman::Header"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_Header) == 24, "size of wingman_Header");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_Header) == 8, "alignment of wingman_Header");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_Header, protocol_version) == 0, "offset of wingman_Header.protocol_version");
@@ -105,7 +109,11 @@ typedef struct wingman_VehicleLimits {
     double nz_rate_max_per_s; /* 3-D: bound on |u1| = |Nz'|. [1/s] */
     double bank_rate_max_rps; /* 3-D: bound on |u2| = |mu'|. [rad/s] */
     double altitude_min_m; /* 3-D: lowest altitude z. [m] */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::VehicleLimits";
+#endif
 } wingman_VehicleLimits;
+#define WINGMAN_VEHICLE_LIMITS_TYPE_NAME "wingman::VehicleLimits"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_VehicleLimits) == 72, "size of wingman_VehicleLimits");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_VehicleLimits) == 8, "alignment of wingman_VehicleLimits");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_VehicleLimits, speed_mps) == 0, "offset of wingman_VehicleLimits.speed_mps");
@@ -123,7 +131,11 @@ typedef struct wingman_Weights {
     double alpha; /* Time against running cost, in [0, 1]. */
     double beta; /* Exposure against control effort, in [0, 1]. */
     double stiffness; /* Stiffness s of the exposure sigmoid, > 0. */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::Weights";
+#endif
 } wingman_Weights;
+#define WINGMAN_WEIGHTS_TYPE_NAME "wingman::Weights"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_Weights) == 24, "size of wingman_Weights");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_Weights) == 8, "alignment of wingman_Weights");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_Weights, alpha) == 0, "offset of wingman_Weights.alpha");
@@ -135,7 +147,11 @@ typedef struct wingman_PlanSample {
     double t_s; /* Mission time. [s] */
     double state[7]; /* State (model order, zero-padded). [m, rad, g] */
     double control[2]; /* Control (model order, zero-padded). [rad/s, 1/s] */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::PlanSample";
+#endif
 } wingman_PlanSample;
+#define WINGMAN_PLAN_SAMPLE_TYPE_NAME "wingman::PlanSample"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_PlanSample) == 80, "size of wingman_PlanSample");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_PlanSample) == 8, "alignment of wingman_PlanSample");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_PlanSample, t_s) == 0, "offset of wingman_PlanSample.t_s");
@@ -146,7 +162,11 @@ WINGMAN_STATIC_ASSERT(offsetof(wingman_PlanSample, control) == 64, "offset of wi
 typedef struct wingman_PlanCut {
     uint32_t site; /* The work that was cut. [code] */
     uint32_t step; /* How far it got when it was cut. */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::PlanCut";
+#endif
 } wingman_PlanCut;
+#define WINGMAN_PLAN_CUT_TYPE_NAME "wingman::PlanCut"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_PlanCut) == 8, "size of wingman_PlanCut");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_PlanCut) == 4, "alignment of wingman_PlanCut");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_PlanCut, site) == 0, "offset of wingman_PlanCut.site");
@@ -168,7 +188,11 @@ typedef struct wingman_Tasking {
     double final_state[7]; /* Final state for `FixedTime` and `MinTime` (model order, zero-padded); zeros for a rendezvous. [m, rad, g] */
     double final_time_s; /* Fixed final time for `FixedTime`; 0 otherwise. [s] */
     double targets_m[8][3]; /* Intermediate targets in order, `[x, y, z]` (z = 0 in 2-D); `target_count` valid. [m] */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::Tasking";
+#endif
 } wingman_Tasking;
+#define WINGMAN_TASKING_TYPE_NAME "wingman::Tasking"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_Tasking) == 456, "size of wingman_Tasking");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_Tasking) == 8, "alignment of wingman_Tasking");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_Tasking, header) == 0, "offset of wingman_Tasking.header");
@@ -194,7 +218,11 @@ typedef struct wingman_LeadState {
     double speed_mps; /* Ground speed of the lead. [m/s] */
     uint32_t route_revision; /* `revision` of the `LeadRoute` the lead is flying. */
     uint32_t reserved; /* Zero; keeps the next field 8-byte aligned. */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::LeadState";
+#endif
 } wingman_LeadState;
+#define WINGMAN_LEAD_STATE_TYPE_NAME "wingman::LeadState"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_LeadState) == 88, "size of wingman_LeadState");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_LeadState) == 8, "alignment of wingman_LeadState");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_LeadState, header) == 0, "offset of wingman_LeadState.header");
@@ -214,7 +242,11 @@ typedef struct wingman_LeadRoute {
     double start_time_s; /* Mission time at which the lead is at `points_m[0]`. [s] */
     double speed_mps; /* Constant speed along the route. [m/s] */
     double points_m[16][3]; /* Route polyline `[x, y, z]` (z = 0 in 2-D); `point_count` valid. [m] */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::LeadRoute";
+#endif
 } wingman_LeadRoute;
+#define WINGMAN_LEAD_ROUTE_TYPE_NAME "wingman::LeadRoute"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_LeadRoute) == 432, "size of wingman_LeadRoute");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_LeadRoute) == 8, "alignment of wingman_LeadRoute");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_LeadRoute, header) == 0, "offset of wingman_LeadRoute.header");
@@ -243,7 +275,11 @@ typedef struct wingman_ThreatReport {
     double estimate_covariance[9]; /* Moving: covariance of the estimate, row-major 3 x 3, symmetric. [m^2, ...] */
     double accel_sigma_mps2; /* Moving: standard deviation of the Gauss–Markov acceleration. [m/s^2] */
     double accel_tau_s; /* Moving: correlation time tau of the acceleration. [s] */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::ThreatReport";
+#endif
 } wingman_ThreatReport;
+#define WINGMAN_THREAT_REPORT_TYPE_NAME "wingman::ThreatReport"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_ThreatReport) == 656, "size of wingman_ThreatReport");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_ThreatReport) == 8, "alignment of wingman_ThreatReport");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_ThreatReport, header) == 0, "offset of wingman_ThreatReport.header");
@@ -272,7 +308,11 @@ typedef struct wingman_TrackFix {
     double time_s; /* Mission time of the measurement. [s] */
     double position_m[3]; /* Measured position `[x, y, z]` (z = 0 in 2-D). [m] */
     double sigma_m; /* Standard deviation of the measurement along each axis. [m] */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::TrackFix";
+#endif
 } wingman_TrackFix;
+#define WINGMAN_TRACK_FIX_TYPE_NAME "wingman::TrackFix"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_TrackFix) == 72, "size of wingman_TrackFix");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_TrackFix) == 8, "alignment of wingman_TrackFix");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_TrackFix, header) == 0, "offset of wingman_TrackFix.header");
@@ -294,7 +334,11 @@ typedef struct wingman_OwnshipState {
     double cross_track_m; /* Signed distance from the plan across its track (positive left). [m] */
     double along_track_m; /* Signed distance from the plan's point at `time_s` along its track (positive ahead). [m] */
     double vertical_m; /* Height above the plan's point at `time_s` (0 in 2-D). [m] */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::OwnshipState";
+#endif
 } wingman_OwnshipState;
+#define WINGMAN_OWNSHIP_STATE_TYPE_NAME "wingman::OwnshipState"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_OwnshipState) == 144, "size of wingman_OwnshipState");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_OwnshipState) == 8, "alignment of wingman_OwnshipState");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_OwnshipState, header) == 0, "offset of wingman_OwnshipState.header");
@@ -330,7 +374,11 @@ typedef struct wingman_Plan {
     double phase_end_s[9]; /* Mission time at which each phase ends (phase g ends on target g; the last on the final point or the rendezvous). [s] */
     wingman_PlanCut cuts[64]; /* Where the deadline cut the computation, sorted; `cut_count` valid. */
     wingman_PlanSample samples[2048]; /* Trajectory samples in increasing time; `sample_count` valid. */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::Plan";
+#endif
 } wingman_Plan;
+#define WINGMAN_PLAN_TYPE_NAME "wingman::Plan"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_Plan) == 164544, "size of wingman_Plan");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_Plan) == 8, "alignment of wingman_Plan");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_Plan, header) == 0, "offset of wingman_Plan.header");
@@ -369,7 +417,11 @@ typedef struct wingman_PlannerStatus {
     uint64_t popups_clear; /* Pop-ups assessed as clear of the plan (no re-plan). */
     double last_plan_compute_ms; /* Compute time of the newest plan. [ms] */
     double budget_remaining_ms; /* Compute time left in the duty-cycle window. [ms] */
+#ifdef __cplusplus
+    static constexpr const char *IOX2_TYPE_NAME = "wingman::PlannerStatus";
+#endif
 } wingman_PlannerStatus;
+#define WINGMAN_PLANNER_STATUS_TYPE_NAME "wingman::PlannerStatus"
 WINGMAN_STATIC_ASSERT(sizeof(wingman_PlannerStatus) == 112, "size of wingman_PlannerStatus");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_PlannerStatus) == 8, "alignment of wingman_PlannerStatus");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, header) == 0, "offset of wingman_PlannerStatus.header");

@@ -2,15 +2,17 @@ use crate::validate::{self, Checked, ValidationError};
 use crate::wire_struct;
 
 wire_struct! {
-    /// Starts every message. `sequence` grows by one per message on each service;
-    /// `mission_time_ns` is the sender's mission clock when it published.
+    /// Starts every message. A sender's `sequence` grows by one per message it publishes,
+    /// one counter across all its services (so that the planner's status can echo the
+    /// last input it processed); `mission_time_ns` is the sender's mission clock when it
+    /// published.
     #[type_name("wingman::Header")]
     pub struct Header {
         /// `PROTOCOL_VERSION` of the sender.
         pub protocol_version: u32 ["-"],
         /// Who sent it: 1 planner, 2 harness, other values for test tools.
         pub sender_id: u32 ["-"],
-        /// Per-service message counter of the sender, starting at 1.
+        /// The sender's message counter, one across all its services, starting at 1.
         pub sequence: u64 ["-"],
         /// Mission time at publication.
         pub mission_time_ns: i64 ["ns"],

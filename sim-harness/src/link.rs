@@ -169,11 +169,30 @@ impl PlannerLink {
             .map_err(|e| port_err("notify wake/planner", e))
     }
 
-    /// Takes every plan and status published so far; each is validated first (an
+    /// Takes every status and plan published so far; each is validated first (an
     /// invalid one is counted and dropped) and logged.
     pub fn poll(&mut self) -> Result<Received, LinkError> {
         let mut out = Received::default();
         self.ports.update_subscriptions();
+        // The status first: the planner publishes a plan before the status that follows
+        // it, so the plans taken after a status include every plan that status counts.
+        while let Some(sample) = self
+            .ports
+            .status
+            .receive()
+            .map_err(|e| port_err("receive a status", e))?
+        {
+            let s = *sample.payload();
+            drop(sample);
+            self.log.message(Direction::FromPlanner, self.mission_s, &s);
+            match s.validate() {
+                Ok(()) => self.last_status = Some(s),
+                Err(e) => {
+                    out.rejected += 1;
+                    tracing::warn!(error = %e, "dropped an invalid status");
+                }
+            }
+        }
         while let Some(sample) = self
             .ports
             .plan
@@ -195,23 +214,6 @@ impl PlannerLink {
                 Err(e) => {
                     out.rejected += 1;
                     tracing::warn!(error = %e, "dropped an invalid plan");
-                }
-            }
-        }
-        while let Some(sample) = self
-            .ports
-            .status
-            .receive()
-            .map_err(|e| port_err("receive a status", e))?
-        {
-            let s = *sample.payload();
-            drop(sample);
-            self.log.message(Direction::FromPlanner, self.mission_s, &s);
-            match s.validate() {
-                Ok(()) => self.last_status = Some(s),
-                Err(e) => {
-                    out.rejected += 1;
-                    tracing::warn!(error = %e, "dropped an invalid status");
                 }
             }
         }

@@ -22,7 +22,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
@@ -141,7 +140,8 @@ def check_take_off(plan: c.Plan) -> None:
     )
     miss = math.hypot(last[0] - FINAL[0], last[1] - FINAL[1])
     check(miss < 100.0, f"it ends at the final point ({miss:.1f} m)")
-    check(plan.compute_ms <= 501.0, f"within the 500 ms budget ({plan.compute_ms:.0f} ms)")
+    # The deployment budget of a 2-D take-off plan is 500 ms, and the planner aims 20 ms early.
+    check(plan.compute_ms <= 500.0, f"within the 500 ms budget ({plan.compute_ms:.0f} ms)")
 
 
 def fly(client: Client, plan, t_from: float, t_to: float):
@@ -214,8 +214,11 @@ def main() -> int:
     client = Client(a.vehicle)
     planner = start_planner(a.planner, a.vehicle, os.path.join(a.log_dir, "planner-1.log"))
     try:
-        client.wait_for_status()
-        check(True, "the planner opened the services the client created")
+        s = client.wait_for_status()
+        check(
+            s.header.sender_id == c.SENDER_PLANNER,
+            "the planner opened the services the client created (its status came)",
+        )
         plan = take_off(client)
         check_take_off(plan)
 
@@ -247,9 +250,8 @@ def main() -> int:
     vehicle = a.vehicle + "-b"
     planner = start_planner(a.planner, vehicle, os.path.join(a.log_dir, "planner-2.log"))
     try:
-        time.sleep(0.5)
-        client = Client(vehicle)
-        client.wait_for_status()
+        client = Client.connect(vehicle)
+        check(client.wait_for_status() is not None, "a client opened the services the planner created")
         check_take_off(take_off(client))
     finally:
         code = stop_planner(planner)

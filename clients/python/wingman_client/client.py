@@ -27,13 +27,14 @@ def _copy(sample, message_type):
 
 class Client:
     """The services of `vehicle_id`, opened or created with the contract's settings (either
-    side may start first). Inputs carry this sender's id and one sequence counter across
-    all input services."""
+    side may start first; `create=False`: opened only, they must exist). Inputs carry this
+    sender's id and one sequence counter across all input services."""
 
-    def __init__(self, vehicle_id: str, sender_id: int = c.SENDER_HARNESS):
+    def __init__(self, vehicle_id: str, sender_id: int = c.SENDER_HARNESS, create: bool = True):
         iox2.set_log_level_from_env_or(iox2.LogLevel.Error)
         self.vehicle_id = vehicle_id
         self.sender_id = sender_id
+        self.create = create
         self.sequence = 0
         self.node = iox2.NodeBuilder.new().create(iox2.ServiceType.Ipc)
         self.publishers = {
@@ -59,7 +60,7 @@ class Client:
 
     def _pubsub(self, service: str):
         s = c.SETTINGS[service]
-        return (
+        builder = (
             self.node.service_builder(self._name(service))
             .publish_subscribe(c.MESSAGES[service])
             .enable_safe_overflow(True)
@@ -68,8 +69,8 @@ class Client:
             .max_publishers(s["max_publishers"])
             .max_subscribers(s["max_subscribers"])
             .max_nodes(s["max_nodes"])
-            .open_or_create()
         )
+        return builder.open_or_create() if self.create else builder.open()
 
     def _subscriber(self, service: str):
         s = c.SETTINGS[service]
@@ -83,14 +84,27 @@ class Client:
 
     def _event(self, service: str):
         s = c.SETTINGS[service]
-        return (
+        builder = (
             self.node.service_builder(self._name(service))
             .event()
-            .max_notifiers(s["max_publishers"])
-            .max_listeners(s["max_subscribers"])
+            .max_notifiers(s["max_notifiers"])
+            .max_listeners(s["max_listeners"])
             .max_nodes(s["max_nodes"])
-            .open_or_create()
         )
+        return builder.open_or_create() if self.create else builder.open()
+
+    @classmethod
+    def connect(cls, vehicle_id: str, timeout_s: float = 30.0, **kwargs) -> "Client":
+        """A client of services that another process (the planner) creates: waits until they
+        exist, then opens them (never creates them)."""
+        deadline = time.monotonic() + timeout_s
+        while True:
+            try:
+                return cls(vehicle_id, create=False, **kwargs)
+            except (iox2.PublishSubscribeOpenError, iox2.EventOpenError):
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.05)
 
     def publish(self, service: str, message, mission_time_s: float) -> int:
         """Stamps `message`'s header (this sender, the next sequence, the mission time) and
@@ -108,11 +122,13 @@ class Client:
 
     def poll(self) -> list:
         """Takes the plans and status that arrived; returns the new plans."""
+        # The status first: the planner publishes a plan before the status that follows
+        # it, so plans read after a status include every plan that status counts.
+        while (sample := self._status.receive()) is not None:
+            self.status = _copy(sample, c.PlannerStatus)
         new = []
         while (sample := self._plans.receive()) is not None:
             new.append(_copy(sample, c.Plan))
-        while (sample := self._status.receive()) is not None:
-            self.status = _copy(sample, c.PlannerStatus)
         self.plans.extend(new)
         return new
 

@@ -53,8 +53,8 @@ SETTINGS = {
     "Ownship": {"history_size": 0, "subscriber_max_buffer_size": 4, "max_publishers": 2, "max_subscribers": 4, "max_nodes": 16},
     "Plan": {"history_size": 1, "subscriber_max_buffer_size": 2, "max_publishers": 2, "max_subscribers": 4, "max_nodes": 16},
     "Status": {"history_size": 1, "subscriber_max_buffer_size": 4, "max_publishers": 2, "max_subscribers": 8, "max_nodes": 16},
-    "PlannerWake": {"history_size": 0, "subscriber_max_buffer_size": 0, "max_publishers": 8, "max_subscribers": 4, "max_nodes": 16},
-    "HarnessWake": {"history_size": 0, "subscriber_max_buffer_size": 0, "max_publishers": 8, "max_subscribers": 4, "max_nodes": 16},
+    "PlannerWake": {"max_notifiers": 8, "max_listeners": 4, "max_nodes": 16},
+    "HarnessWake": {"max_notifiers": 8, "max_listeners": 4, "max_nodes": 16},
 }
 
 # Model: Vehicle model; the wire value is the model's dimension.
@@ -97,7 +97,7 @@ PLANNER_STATE_DEGRADED = 2
 
 
 class Header(ctypes.Structure):
-    """Starts every message. `sequence` grows by one per message on each service; `mission_time_ns` is the sender's mission clock when it published."""
+    """Starts every message. A sender's `sequence` grows by one per message it publishes, one counter across all its services (so that the planner's status can echo the last input it processed); `mission_time_ns` is the sender's mission clock when it published."""
 
     _fields_ = [
         ("protocol_version", ctypes.c_uint32),

@@ -10,7 +10,7 @@ use core::fmt::Write;
 use serde_json::{Value, json};
 use wingman_interfaces::Service;
 use wingman_interfaces::doc::{self, EnumType, WireType};
-use wingman_interfaces::layout::{Element, FieldInfo};
+use wingman_interfaces::layout::{Element, FieldInfo, Scalar};
 
 use crate::{WAKE_HARNESS, WAKE_INPUT, WAKE_SOLVER, qos};
 
@@ -40,12 +40,17 @@ pub fn services_markdown() -> String {
     let mut out = String::new();
     out.push_str(
         "## Service settings\n\n\
-         Either process may create a service; the other opens it, and iceoryx2 refuses the \
-         open when a setting below differs. A client that creates a service must give it \
-         exactly these settings (publish-subscribe: safe overflow on, the history, the \
-         subscriber buffer, the publisher, subscriber and node counts; event: the \
-         notifier, listener and node counts). Its subscribers ask for the whole history \
-         and use the buffer size; its publishers loan one sample at a time.\n\n",
+         Either process may create a service; the other opens it. iceoryx2 refuses the \
+         open when the payload type differs (its type name, the `iceoryx2 type name` of \
+         the tables above, its size, an alignment over the creator's), when the user header \
+         is not none (`()`, size 0, alignment 1), when safe overflow differs, or when the \
+         service holds less than the opener asks for (history, subscriber buffer, \
+         publishers or notifiers, subscribers or listeners, nodes). So a client that \
+         creates a service gives it these settings, and one that opens a service asks for \
+         no more than these. The planner's subscribers ask for the whole history and use \
+         the buffer size; its publishers loan one sample at a time. An event service \
+         created by a client must allow event ids up to 3 (`event_id_max_value`; \
+         iceoryx2's default allows more).\n\n",
     );
     out.push_str(
         "| service | name | kind | history | subscriber buffer | max publishers / notifiers | \
@@ -197,12 +202,12 @@ fn upper_snake(name: &str) -> String {
 
 fn c_scalar(element: Element) -> String {
     match element {
-        Element::Scalar(s) => match s.name() {
-            "f64" => "double".into(),
-            "i64" => "int64_t".into(),
-            "u64" => "uint64_t".into(),
-            "u32" => "uint32_t".into(),
-            _ => "uint8_t".into(),
+        Element::Scalar(s) => match s {
+            Scalar::F64 => "double".into(),
+            Scalar::I64 => "int64_t".into(),
+            Scalar::U64 => "uint64_t".into(),
+            Scalar::U32 => "uint32_t".into(),
+            Scalar::U8 => "uint8_t".into(),
         },
         Element::Struct { name, .. } => format!("wingman_{name}"),
     }
@@ -227,7 +232,19 @@ fn c_struct(out: &mut String, t: &WireType) {
             one_line(f.doc).replace("*/", "* /")
         );
     }
+    // iceoryx2-cxx takes a payload's type name from `IOX2_TYPE_NAME`: the Rust side's.
+    let _ = writeln!(
+        out,
+        "#ifdef __cplusplus\n    static constexpr const char *IOX2_TYPE_NAME = \"{}\";\n#endif",
+        t.type_name
+    );
     let _ = writeln!(out, "}} {name};");
+    let _ = writeln!(
+        out,
+        "#define WINGMAN_{}_TYPE_NAME \"{}\"",
+        upper_snake(t.name),
+        t.type_name
+    );
     let _ = writeln!(
         out,
         "WINGMAN_STATIC_ASSERT(sizeof({name}) == {}, \"size of {name}\");",
@@ -313,12 +330,12 @@ pub fn c_header() -> String {
 
 fn py_type(f: &FieldInfo) -> String {
     let base = match f.element {
-        Element::Scalar(s) => match s.name() {
-            "f64" => "ctypes.c_double".to_string(),
-            "i64" => "ctypes.c_int64".into(),
-            "u64" => "ctypes.c_uint64".into(),
-            "u32" => "ctypes.c_uint32".into(),
-            _ => "ctypes.c_uint8".into(),
+        Element::Scalar(s) => match s {
+            Scalar::F64 => "ctypes.c_double".to_string(),
+            Scalar::I64 => "ctypes.c_int64".into(),
+            Scalar::U64 => "ctypes.c_uint64".into(),
+            Scalar::U32 => "ctypes.c_uint32".into(),
+            Scalar::U8 => "ctypes.c_uint8".into(),
         },
         Element::Struct { name, .. } => name.to_string(),
     };
@@ -380,12 +397,23 @@ pub fn python_module() -> String {
     );
     for s in Service::ALL {
         let q = qos(s);
-        let _ = writeln!(
-            out,
-            "    \"{s:?}\": {{\"history_size\": {}, \"subscriber_max_buffer_size\": {}, \
-             \"max_publishers\": {}, \"max_subscribers\": {}, \"max_nodes\": {}}},",
-            q.history_size, q.subscriber_buffer, q.max_publishers, q.max_subscribers, q.max_nodes
-        );
+        let _ = match doc::payload(s) {
+            Some(_) => writeln!(
+                out,
+                "    \"{s:?}\": {{\"history_size\": {}, \"subscriber_max_buffer_size\": {}, \
+                 \"max_publishers\": {}, \"max_subscribers\": {}, \"max_nodes\": {}}},",
+                q.history_size,
+                q.subscriber_buffer,
+                q.max_publishers,
+                q.max_subscribers,
+                q.max_nodes
+            ),
+            None => writeln!(
+                out,
+                "    \"{s:?}\": {{\"max_notifiers\": {}, \"max_listeners\": {}, \"max_nodes\": {}}},",
+                q.max_publishers, q.max_subscribers, q.max_nodes
+            ),
+        };
     }
     out.push_str("}\n");
     for e in doc::enums() {
