@@ -11,6 +11,8 @@ in Python would, and checks what the contract promises. Also the example of the 
 3. Every kind of bad input is rejected and counted; the planner lives on, its plan and its
    plan count unchanged.
 4. The other order: the planner first, then a client; the take-off plan comes.
+5. The tasking and threats published before the planner starts reach it from the
+   services' history: its take-off plan comes with only a fresh ownship state sent after.
 
 Exits 0 when every check holds; prints each check as it goes.
 """
@@ -256,6 +258,29 @@ def main() -> int:
     finally:
         code = stop_planner(planner)
     check(code == 0, f"the second planner stopped cleanly (exit {code})")
+
+    # 5. Inputs published before the planner exists, delivered from history.
+    vehicle = a.vehicle + "-c"
+    client = Client(vehicle)
+    client.publish("Tasking", tasking(), 0.0)
+    for k, (name, centre, axes) in enumerate(THREATS):
+        client.publish("Threats", threat(k + 1, name, centre, axes, 0.0), 0.0)
+    planner = start_planner(a.planner, vehicle, os.path.join(a.log_dir, "planner-3.log"))
+    try:
+        client.wait_for_status()
+        client.publish("Ownship", ownship(None, 0.0), 0.0)
+        plans = client.sync()
+        check(
+            len(plans) == 1 and plans[0].trigger == c.TRIGGER_INITIAL,
+            "the tasking and threats published before the planner started reached it (history)",
+        )
+        check(
+            client.status.messages_received >= 1 + len(THREATS) + 1,
+            f"… all of them ({client.status.messages_received} messages received)",
+        )
+    finally:
+        code = stop_planner(planner)
+    check(code == 0, f"the third planner stopped cleanly (exit {code})")
     print("every check holds")
     return 0
 

@@ -11,6 +11,8 @@ from . import contract as c
 
 #: The planner's input services, which a client publishes.
 INPUTS = ("Tasking", "LeadRoute", "LeadState", "Threats", "Tracks", "Ownship")
+#: The inputs whose publishers keep a history for a planner that joins later.
+HISTORY = tuple(n for n in INPUTS if c.SETTINGS[n]["history_size"] > 0)
 
 
 class PlannerTimeout(RuntimeError):
@@ -117,7 +119,10 @@ class Client:
         return self.sequence
 
     def notify(self) -> None:
-        """Wakes the planner (`WAKE_INPUT`)."""
+        """Hands the history services' samples to subscribers that joined since (a planner
+        started or restarted after them), then wakes the planner (`WAKE_INPUT`)."""
+        for name in HISTORY:
+            self.publishers[name].update_connections()
         self._wake.notify()
 
     def poll(self) -> list:
