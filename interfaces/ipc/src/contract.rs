@@ -35,6 +35,74 @@ pub fn wake_events() -> [(&'static str, usize, &'static str); 3] {
     ]
 }
 
+/// A service's settings as a client that creates it must give them.
+enum Settings {
+    PubSub {
+        payload: &'static str,
+        history: usize,
+        buffer: usize,
+        publishers: usize,
+        subscribers: usize,
+        nodes: usize,
+    },
+    Event {
+        notifiers: usize,
+        listeners: usize,
+        nodes: usize,
+    },
+}
+
+fn settings(s: Service) -> Settings {
+    let q = qos(s);
+    match doc::payload(s) {
+        Some(payload) => Settings::PubSub {
+            payload,
+            history: q.history_size,
+            buffer: q.subscriber_buffer,
+            publishers: q.max_publishers,
+            subscribers: q.max_subscribers,
+            nodes: q.max_nodes,
+        },
+        None => Settings::Event {
+            notifiers: q.max_publishers,
+            listeners: q.max_subscribers,
+            nodes: q.max_nodes,
+        },
+    }
+}
+
+/// The wire types in the order a declaration needs them: the structs inside messages,
+/// then the messages.
+fn declaration_order() -> impl Iterator<Item = WireType> {
+    doc::structs().into_iter().chain(doc::messages())
+}
+
+/// Every enum value as a constant: (`MODEL_TWO_D`, 2).
+fn enum_constants() -> Vec<(String, u32)> {
+    doc::enums()
+        .iter()
+        .flat_map(|e| {
+            e.variants.iter().map(|(name, value, _)| {
+                (
+                    format!("{}_{}", upper_snake(e.name), upper_snake(name)),
+                    *value,
+                )
+            })
+        })
+        .collect()
+}
+
+/// A scalar's type in C and in Python `ctypes`.
+fn scalar_types(s: Scalar) -> (&'static str, &'static str) {
+    match s {
+        Scalar::F64 => ("double", "ctypes.c_double"),
+        Scalar::I64 => ("int64_t", "ctypes.c_int64"),
+        Scalar::U64 => ("uint64_t", "ctypes.c_uint64"),
+        Scalar::U32 => ("uint32_t", "ctypes.c_uint32"),
+        Scalar::U8 => ("uint8_t", "ctypes.c_uint8"),
+    }
+}
+
 /// The services' settings and the wake event ids, as `docs/INTERFACES.md` shows them.
 pub fn services_markdown() -> String {
     let mut out = String::new();
@@ -58,23 +126,28 @@ pub fn services_markdown() -> String {
          |---|---|---|---:|---:|---:|---:|---:|---|\n",
     );
     for s in Service::ALL {
-        let q = qos(s);
-        let (kind, history, buffer, overflow) = match doc::payload(s) {
-            Some(p) => (
-                format!("publish-subscribe `{p}`"),
-                q.history_size.to_string(),
-                q.subscriber_buffer.to_string(),
-                "yes",
+        let row = match settings(s) {
+            Settings::PubSub {
+                payload,
+                history,
+                buffer,
+                publishers,
+                subscribers,
+                nodes,
+            } => format!(
+                "publish-subscribe `{payload}` | {history} | {buffer} | {publishers} | \
+                 {subscribers} | {nodes} | yes"
             ),
-            None => ("event".to_string(), "-".into(), "-".into(), "-"),
+            Settings::Event {
+                notifiers,
+                listeners,
+                nodes,
+            } => format!("event | - | - | {notifiers} | {listeners} | {nodes} | -"),
         };
         let _ = writeln!(
             out,
-            "| `{s:?}` | `wingman/<vehicle-id>/{}` | {kind} | {history} | {buffer} | {} | {} | {} | {overflow} |",
-            s.suffix(),
-            q.max_publishers,
-            q.max_subscribers,
-            q.max_nodes
+            "| `{s:?}` | `wingman/<vehicle-id>/{}` | {row} |",
+            s.suffix()
         );
     }
     out.push_str("\n## Wake event ids\n\n| name | id | use |\n|---|---:|---|\n");
@@ -146,28 +219,38 @@ pub fn contract_json() -> Value {
     let services: Vec<Value> = Service::ALL
         .iter()
         .map(|s| {
-            let q = qos(*s);
             let name = format!("wingman/<vehicle-id>/{}", s.suffix());
-            match doc::payload(*s) {
-                Some(payload) => json!({
+            match settings(*s) {
+                Settings::PubSub {
+                    payload,
+                    history,
+                    buffer,
+                    publishers,
+                    subscribers,
+                    nodes,
+                } => json!({
                     "service": format!("{s:?}"),
                     "name": name,
                     "kind": "publish_subscribe",
                     "payload": payload,
-                    "history_size": q.history_size,
-                    "subscriber_max_buffer_size": q.subscriber_buffer,
-                    "max_publishers": q.max_publishers,
-                    "max_subscribers": q.max_subscribers,
-                    "max_nodes": q.max_nodes,
+                    "history_size": history,
+                    "subscriber_max_buffer_size": buffer,
+                    "max_publishers": publishers,
+                    "max_subscribers": subscribers,
+                    "max_nodes": nodes,
                     "enable_safe_overflow": true,
                 }),
-                None => json!({
+                Settings::Event {
+                    notifiers,
+                    listeners,
+                    nodes,
+                } => json!({
                     "service": format!("{s:?}"),
                     "name": name,
                     "kind": "event",
-                    "max_notifiers": q.max_publishers,
-                    "max_listeners": q.max_subscribers,
-                    "max_nodes": q.max_nodes,
+                    "max_notifiers": notifiers,
+                    "max_listeners": listeners,
+                    "max_nodes": nodes,
                 }),
             }
         })
@@ -202,13 +285,7 @@ fn upper_snake(name: &str) -> String {
 
 fn c_scalar(element: Element) -> String {
     match element {
-        Element::Scalar(s) => match s {
-            Scalar::F64 => "double".into(),
-            Scalar::I64 => "int64_t".into(),
-            Scalar::U64 => "uint64_t".into(),
-            Scalar::U32 => "uint32_t".into(),
-            Scalar::U8 => "uint8_t".into(),
-        },
+        Element::Scalar(s) => scalar_types(s).0.to_string(),
         Element::Struct { name, .. } => format!("wingman_{name}"),
     }
 }
@@ -306,22 +383,16 @@ pub fn c_header() -> String {
         );
     }
     out.push_str("\n/* Enum values (u32 fields) */\n");
-    for e in doc::enums() {
-        for (name, value, _) in e.variants {
-            let _ = writeln!(
-                out,
-                "#define WINGMAN_{}_{} {value}",
-                upper_snake(e.name),
-                upper_snake(name)
-            );
+    for (name, value) in enum_constants() {
+        let _ = writeln!(out, "#define WINGMAN_{name} {value}");
+    }
+    let structs = doc::structs().len();
+    for (k, t) in declaration_order().enumerate() {
+        match k {
+            0 => out.push_str("\n/* Structs inside messages */\n\n"),
+            k if k == structs => out.push_str("/* Messages */\n\n"),
+            _ => {}
         }
-    }
-    out.push_str("\n/* Structs inside messages */\n\n");
-    for t in doc::structs() {
-        c_struct(&mut out, &t);
-    }
-    out.push_str("/* Messages */\n\n");
-    for t in doc::messages() {
         c_struct(&mut out, &t);
     }
     out.push_str("#endif /* WINGMAN_H */\n");
@@ -330,13 +401,7 @@ pub fn c_header() -> String {
 
 fn py_type(f: &FieldInfo) -> String {
     let base = match f.element {
-        Element::Scalar(s) => match s {
-            Scalar::F64 => "ctypes.c_double".to_string(),
-            Scalar::I64 => "ctypes.c_int64".into(),
-            Scalar::U64 => "ctypes.c_uint64".into(),
-            Scalar::U32 => "ctypes.c_uint32".into(),
-            Scalar::U8 => "ctypes.c_uint8".into(),
-        },
+        Element::Scalar(s) => scalar_types(s).1.to_string(),
         Element::Struct { name, .. } => name.to_string(),
     };
     // C order: the last dimension is the innermost array.
@@ -396,22 +461,28 @@ pub fn python_module() -> String {
         "}\n\n# The settings iceoryx2 compares when a second process opens a service.\nSETTINGS = {\n",
     );
     for s in Service::ALL {
-        let q = qos(s);
-        let _ = match doc::payload(s) {
-            Some(_) => writeln!(
+        let _ = match settings(s) {
+            Settings::PubSub {
+                history,
+                buffer,
+                publishers,
+                subscribers,
+                nodes,
+                ..
+            } => writeln!(
                 out,
-                "    \"{s:?}\": {{\"history_size\": {}, \"subscriber_max_buffer_size\": {}, \
-                 \"max_publishers\": {}, \"max_subscribers\": {}, \"max_nodes\": {}}},",
-                q.history_size,
-                q.subscriber_buffer,
-                q.max_publishers,
-                q.max_subscribers,
-                q.max_nodes
+                "    \"{s:?}\": {{\"history_size\": {history}, \"subscriber_max_buffer_size\": \
+                 {buffer}, \"max_publishers\": {publishers}, \"max_subscribers\": {subscribers}, \
+                 \"max_nodes\": {nodes}}},"
             ),
-            None => writeln!(
+            Settings::Event {
+                notifiers,
+                listeners,
+                nodes,
+            } => writeln!(
                 out,
-                "    \"{s:?}\": {{\"max_notifiers\": {}, \"max_listeners\": {}, \"max_nodes\": {}}},",
-                q.max_publishers, q.max_subscribers, q.max_nodes
+                "    \"{s:?}\": {{\"max_notifiers\": {notifiers}, \"max_listeners\": {listeners}, \
+                 \"max_nodes\": {nodes}}},"
             ),
         };
     }
@@ -428,11 +499,7 @@ pub fn python_module() -> String {
         }
     }
     out.push('\n');
-    for t in doc::structs() {
-        py_struct(&mut out, &t);
-        out.push('\n');
-    }
-    for t in doc::messages() {
+    for t in declaration_order() {
         py_struct(&mut out, &t);
         out.push('\n');
     }

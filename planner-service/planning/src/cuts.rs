@@ -270,8 +270,9 @@ impl CutLog {
 
     /// Records a cut the work took by other means (the solver's own wall-time limit).
     pub(crate) fn note(&self, site: Site, step: u32) {
-        if !self.replaying() {
-            self.lock_taken(Cut { site, step });
+        let mut state = self.lock();
+        if matches!(state.mode, Mode::Recording) {
+            state.taken.push(Cut { site, step });
         }
     }
 
