@@ -264,6 +264,7 @@ fn main() {
         host.push(host_reference_ms());
     }
     print_tables(&mut tallies);
+    print_summary(&tallies);
     println!("\nEvents over 1.005 x the yardstick at 50 ms (2-D) / 150 ms (3-D):");
     for o in &outliers {
         println!("- {o}");
@@ -335,6 +336,39 @@ fn record(tally: &mut Tally, budget: u64, out: &PlanOutcome, yardstick: f64) {
         .entry(q)
         .or_default() += 1;
     *tally.warm.entry(budget).or_default() += usize::from(out.path == PlanPath::Warm);
+}
+
+/// Issue 31's yardsticks per model, over the re-plan events (tasking changes apart: they
+/// cannot start warm): the median time to `Optimal`, and at the judged budget the share
+/// within 1.005 of the yardstick and the worst ratio.
+fn print_summary(tallies: &BTreeMap<(usize, &'static str), Tally>) {
+    println!(
+        "\n| model | re-plan events | time to Optimal ms, median | judged budget ms | within 1.005 | worst |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|");
+    for dim in [2, 3] {
+        let budget = judged_budget(dim);
+        let replans = || {
+            tallies
+                .iter()
+                .filter(move |((d, kind), _)| *d == dim && *kind != "tasking")
+                .map(|(_, t)| t)
+        };
+        let mut first: Vec<f64> = replans().flat_map(|t| t.first_optimal.clone()).collect();
+        let ratios: Vec<f64> = replans().flat_map(|t| t.ratio[&budget].clone()).collect();
+        if first.is_empty() {
+            continue;
+        }
+        first.sort_by(f64::total_cmp);
+        let within = ratios.iter().filter(|&&v| v <= 1.005).count();
+        let worst = ratios.iter().copied().fold(f64::NAN, f64::max);
+        println!(
+            "| {dim}-D | {} | {:.1} | {budget} | {within}/{} | {worst:.4} |",
+            first.len(),
+            percentile(&first, 0.5),
+            ratios.len(),
+        );
+    }
 }
 
 fn print_tables(tallies: &mut BTreeMap<(usize, &'static str), Tally>) {
