@@ -140,9 +140,11 @@ pub(super) fn solve_on_mesh(
 
 /// The floor of a budget that may not hold the NLP stage: one solve of the swarm's best
 /// (`swarm_path`, lifted; the fallback flown with the tracking law was a worse start: a 3-D
-/// rendezvous floor did not converge from it) on its coarse ranking mesh at the finalists' settings (their tight constraint
-/// tolerance), accepted only as feasible as a refined solve must be. A plan from it is `Feasible` (a coarse mesh's solution, neither
-/// refined nor compared with other basins); it is kept when the stage yields nothing.
+/// rendezvous floor did not converge from it) on its coarse ranking mesh at
+/// `PlannerSettings::floor_nlp` (the finalists' tight constraint tolerance, the ranking's
+/// plain line search), accepted only as feasible as a refined solve must be. A plan from
+/// it is `Feasible` (a coarse mesh's solution, neither refined nor compared with other
+/// basins); it is kept when the stage yields nothing.
 pub(super) fn floor(
     problem: &Problem,
     settings: &PlannerSettings,
@@ -159,7 +161,7 @@ pub(super) fn floor(
         mesh: &mesh,
         guess: swarm_path,
         settings,
-        nlp_settings: &settings.finalist_nlp,
+        nlp_settings: &settings.floor_nlp,
         refined: false,
         feasibility_tol: settings.nlp.feasibility_tol,
         warm_from: None,

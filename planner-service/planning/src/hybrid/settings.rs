@@ -37,6 +37,8 @@ pub struct PlannerSettings {
     pub ranking_nlp: NlpSettings,
     /// The NLP settings of the finalists' solves on the working mesh.
     pub finalist_nlp: NlpSettings,
+    /// The NLP settings of the floor's solve under a short budget (`nlp_stage::floor`).
+    pub floor_nlp: NlpSettings,
     pub refine: RefineSettings,
     /// Refinement rounds after the first NLP solve.
     pub refine_rounds: usize,
@@ -83,6 +85,13 @@ pub struct PlannerSettings {
 /// `docs/decisions/` (the record named beside it).
 impl Default for PlannerSettings {
     fn default() -> Self {
+        // A refined solve or a polish follows; feasible as the refined ones (0022).
+        let finalist_nlp = NlpSettings::default()
+            .with_feral_static_pivoting(true)
+            .with_tol(1e-5)
+            .with_acceptable_tol(1e-4)
+            .with_acceptable_constr_viol_tol(Some(1e-7))
+            .with_constr_viol_tol(Some(1e-7));
         PlannerSettings {
             swarm: SwarmSettings::default(),
             mesh: MeshSettings::default(),
@@ -102,13 +111,11 @@ impl Default for PlannerSettings {
                 .with_acceptable_constr_viol_tol(Some(1e-3))
                 .with_second_order_check(false)
                 .with_second_order_corrections(false),
-            // A refined solve or a polish follows; feasible as the refined ones (0022).
-            finalist_nlp: NlpSettings::default()
-                .with_feral_static_pivoting(true)
-                .with_tol(1e-5)
-                .with_acceptable_tol(1e-4)
-                .with_acceptable_constr_viol_tol(Some(1e-7))
-                .with_constr_viol_tol(Some(1e-7)),
+            // The floor: as feasible as a finalist, with no second-order corrections, as the
+            // ranking solves on the same coarse mesh (0027): with them a 3-D rendezvous
+            // floor wandered for 49 iterations and was cut at 150 ms (0035).
+            floor_nlp: finalist_nlp.clone().with_second_order_corrections(false),
+            finalist_nlp,
             refine: RefineSettings::default(),
             refine_rounds: 1, // more moved no cost, took 20-30 % of the plan (0011)
             export: ExportSettings::default(),
@@ -168,6 +175,7 @@ impl PlannerSettings {
             ("nlp", &self.nlp),
             ("ranking_nlp", &self.ranking_nlp),
             ("finalist_nlp", &self.finalist_nlp),
+            ("floor_nlp", &self.floor_nlp),
         ] {
             nlp.validate()
                 .map_err(|source| PlannerSettingsError::Nlp { stage, source })?;
