@@ -80,7 +80,7 @@
 
 /* Structs inside messages */
 
-/* Starts every message. A sender's `sequence` grows by one per message it publishes, one counter across all its services (so that the planner's status can echo the last input it processed); `mission_time_ns` is the sender's mission clock when it published. */
+/* Starts every message. A sender's `sequence` grows by one per message it publishes, one counter across all its services, so that the planner's status can echo the last input it accepted. On each input service the planner accepts a message only if its `sequence` is greater than the one of the sender's previous accepted message there and its `mission_time_ns` (the sender's mission clock when it published) not smaller: a repeat or a step back is rejected. */
 typedef struct wingman_Header {
     uint32_t protocol_version; /* `PROTOCOL_VERSION` of the sender. */
     uint32_t sender_id; /* Who sent it: 1 planner, 2 harness, other values for test tools. */
@@ -407,10 +407,10 @@ typedef struct wingman_PlannerStatus {
     wingman_Header header; /* Common header. */
     uint32_t state; /* `PlannerState` value. [enum] */
     uint32_t stale_inputs; /* Bits `STALE_*` of inputs that stopped arriving. [bits] */
-    uint64_t last_input_sequence; /* Highest header `sequence` processed over all input services (the harness's lock-step clock waits for it). */
+    uint64_t last_input_sequence; /* Highest header `sequence` of an accepted input message, over all input services (a rejected message's is not echoed; a lock-step client waits for it). */
     uint64_t current_plan_id; /* `plan_id` of the newest published plan (0: none). */
     uint64_t messages_received; /* Messages taken from every input service. */
-    uint64_t messages_rejected; /* Messages that failed `validate()`, dropped. */
+    uint64_t messages_rejected; /* Messages rejected and dropped: failed `validate()`, or a header that does not follow the sender's previous one on its service. */
     uint64_t plans_made; /* Plans published. */
     uint64_t triggers_coalesced; /* Triggers folded into a plan already pending. */
     uint64_t triggers_deferred; /* Triggers held back by the minimum spacing or the duty-cycle cap. */

@@ -3,9 +3,11 @@ use crate::wire_struct;
 
 wire_struct! {
     /// Starts every message. A sender's `sequence` grows by one per message it publishes,
-    /// one counter across all its services (so that the planner's status can echo the
-    /// last input it processed); `mission_time_ns` is the sender's mission clock when it
-    /// published.
+    /// one counter across all its services, so that the planner's status can echo the last
+    /// input it accepted. On each input service the planner accepts a message only if its
+    /// `sequence` is greater than the one of the sender's previous accepted message there
+    /// and its `mission_time_ns` (the sender's mission clock when it published) not
+    /// smaller: a repeat or a step back is rejected.
     #[type_name("wingman::Header")]
     pub struct Header {
         /// `PROTOCOL_VERSION` of the sender.
@@ -41,8 +43,14 @@ impl Header {
     }
 
     /// Checks that this header may follow `previous` from the same sender on the same
-    /// service: the mission clock must not go backwards.
+    /// service: the sequence must grow and the mission clock must not go backwards.
     pub fn check_follows(&self, previous: &Header) -> Checked {
+        if self.sequence <= previous.sequence {
+            return Err(ValidationError::SequenceNotIncreasing {
+                previous: previous.sequence,
+                found: self.sequence,
+            });
+        }
         if self.mission_time_ns < previous.mission_time_ns {
             return Err(ValidationError::TimeBackwards {
                 field: "header.mission_time_ns",

@@ -21,14 +21,15 @@ wire_struct! {
         pub state: u32 ["enum"],
         /// Bits `STALE_*` of inputs that stopped arriving.
         pub stale_inputs: u32 ["bits"],
-        /// Highest header `sequence` processed over all input services (the harness's
-        /// lock-step clock waits for it).
+        /// Highest header `sequence` of an accepted input message, over all input services
+        /// (a rejected message's is not echoed; a lock-step client waits for it).
         pub last_input_sequence: u64 ["-"],
         /// `plan_id` of the newest published plan (0: none).
         pub current_plan_id: u64 ["-"],
         /// Messages taken from every input service.
         pub messages_received: u64 ["-"],
-        /// Messages that failed `validate()`, dropped.
+        /// Messages rejected and dropped: failed `validate()`, or a header that does not
+        /// follow the sender's previous one on its service.
         pub messages_rejected: u64 ["-"],
         /// Plans published.
         pub plans_made: u64 ["-"],

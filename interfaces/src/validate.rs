@@ -40,6 +40,9 @@ pub enum ValidationError {
         field: &'static str,
         problem: &'static str,
     },
+    /// A sender's header sequence does not grow on a service: a repeat or a step back.
+    #[error("header sequence {found} does not follow {previous}")]
+    SequenceNotIncreasing { previous: u64, found: u64 },
 }
 
 impl ValidationError {
@@ -53,6 +56,7 @@ impl ValidationError {
             ValidationError::UnknownEnum { .. } => "unknown-enum",
             ValidationError::TimeBackwards { .. } => "time-backwards",
             ValidationError::OutOfRange { .. } => "out-of-range",
+            ValidationError::SequenceNotIncreasing { .. } => "sequence-not-increasing",
         }
     }
 }

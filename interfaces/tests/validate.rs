@@ -388,6 +388,26 @@ fn header_time_must_not_go_backwards() {
     );
 }
 
+#[test]
+fn header_sequence_must_grow() {
+    let a = common::header(1);
+    let mut b = a;
+    // A gap is fine (the sender's one counter also numbers its other services).
+    b.sequence = a.sequence + 5;
+    assert_eq!(b.check_follows(&a), Ok(()));
+    for found in [a.sequence, a.sequence - 1] {
+        b.sequence = found;
+        assert_eq!(
+            b.check_follows(&a),
+            Err(ValidationError::SequenceNotIncreasing {
+                previous: a.sequence,
+                found
+            }),
+            "a repeat or a step back"
+        );
+    }
+}
+
 /// Validates `bytes` read as `M`; a message that passes holds only finite numbers.
 fn survives<M: Message>(bytes: &[u8]) {
     let m = M::read_from_bytes(bytes).expect("length");

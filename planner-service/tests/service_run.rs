@@ -69,7 +69,13 @@ fn a_tasking_gives_a_plan_and_bad_or_clear_inputs_change_nothing() {
     assert_eq!(s.messages_rejected, 0);
     assert!(s.last_plan_compute_ms > 0.0);
 
-    // An invalid threat report (NaN centre) and a message of another protocol version.
+    // Rejected: an invalid threat report (NaN centre), a message of another protocol
+    // version, and two valid reports whose sequence does not grow on the threats input
+    // (a repeat of the last accepted one's, a step back). Nothing but the count moves:
+    // the status keeps echoing the sequence before them.
+    let echoed = s.last_input_sequence;
+    // `first_plan` sent the scenario's threats, then the tasking.
+    let last_threat = h.sequence - 1;
     h.set_time(5.0);
     let mut bad = static_threat(50, [10000.0, 10000.0, 0.0], [1000.0, 1000.0, 0.0]);
     bad.header = h.header();
@@ -79,23 +85,27 @@ fn a_tasking_gives_a_plan_and_bad_or_clear_inputs_change_nothing() {
     foreign.header = h.header();
     foreign.header.protocol_version = PROTOCOL_VERSION + 1;
     h.send_threat_raw(foreign);
+    for sequence in [last_threat, last_threat - 1] {
+        let mut stale = static_threat(52, [-40000.0, 40000.0, 0.0], [2000.0, 2000.0, 0.0]);
+        stale.header = h.header();
+        stale.header.sequence = sequence;
+        h.send_threat_raw(stale);
+    }
     h.wake();
     assert!(
         h.wait_until(Duration::from_secs(20), |h| h
             .status
-            .is_some_and(|s| s.messages_rejected == 2)),
+            .is_some_and(|s| s.messages_rejected == 4)),
         "rejections not counted: {:?}",
         h.status
     );
-    // The NaN report's header is ours: its sequence counts. The foreign one's (the
-    // highest sent) is not trusted: the status right after it does not echo it.
+    let s = h.last_status();
     assert_eq!(
-        h.last_status().last_input_sequence,
-        bad.header.sequence,
-        "the foreign message's sequence is not echoed"
+        s.last_input_sequence, echoed,
+        "a rejected sequence is echoed"
     );
-    assert_eq!(foreign.header.sequence, h.sequence);
-    // A pop-up far from the plan: assessed, counted, no plan.
+    assert_eq!((s.plans_made, s.popups_clear), (1, 0));
+    // A pop-up far from the plan, numbered on: assessed, counted, no plan.
     h.send_threat(static_threat(
         60,
         [-40000.0, -40000.0, 0.0],
@@ -106,12 +116,12 @@ fn a_tasking_gives_a_plan_and_bad_or_clear_inputs_change_nothing() {
     std::thread::sleep(Duration::from_millis(500));
     h.poll();
     let s = h.last_status();
-    assert_eq!(s.messages_rejected, 2);
+    assert_eq!(s.messages_rejected, 4);
     assert_eq!(s.popups_clear, 1);
     assert_eq!(s.plans_made, 1, "no plan for invalid or clear inputs");
     assert_eq!(s.current_plan_id, 1);
     assert_eq!(h.plans.len(), 1);
-    // The valid message's sequence is echoed; the foreign one's is not trusted.
+    // The accepted message's sequence is echoed.
     assert_eq!(s.last_input_sequence, h.sequence);
 
     let summary = service.stop(|| h.wake()).expect("the service stops");

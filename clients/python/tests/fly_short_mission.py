@@ -159,8 +159,9 @@ def fly(client: Client, plan, t_from: float, t_to: float):
     return plan, new
 
 
-def bad_inputs(client: Client, t: float) -> None:
-    """Every kind of bad input, one at a time: rejected and counted, nothing else moves."""
+def bad_inputs(client: Client, plan, t: float) -> None:
+    """Every kind of bad input, one at a time, while `plan` is flown: rejected and counted,
+    nothing else moves."""
     kinds = []
     nan = ownship(None, t)
     nan.state[0] = float("nan")
@@ -176,32 +177,46 @@ def bad_inputs(client: Client, t: float) -> None:
     back.objective = c.OBJECTIVE_FIXED_TIME
     kinds.append(("a fixed final time before the start", "Tasking", back, None))
     for what, service, message, field in kinds:
-        before = client.status
         if field is not None:
             setattr(message, field[0], field[1])
-        client.publish(service, message, t)
-        client.sync()
-        s = client.status
-        check(
-            s.messages_rejected == before.messages_rejected + 1,
-            f"{what}: rejected and counted",
-        )
-        check(
-            s.plans_made == before.plans_made and s.current_plan_id == before.current_plan_id,
-            f"{what}: no plan made, the plan in flight kept",
-        )
-    # A wrong protocol version: the header itself (publish stamps a good one). The planner
-    # cannot read such a header, so its sequence is not echoed: wait for the count.
-    before = client.status
+        expect_rejected(client, what, lambda: client.publish(service, message, t))
+    # The header itself (publish stamps a good one): a wrong protocol version, and a
+    # sequence that does not grow on its service (an accepted ownship state's, again).
     o = ownship(None, t)
     o.header = c.Header(c.PROTOCOL_VERSION + 1, client.sender_id, client.sequence + 1, round(t * 1e9))
-    client.publishers["Ownship"].send_copy(o)
+    expect_rejected(client, "a wrong protocol version", lambda: client.publishers["Ownship"].send_copy(o))
+    accepted = client.publish("Ownship", ownship(plan, t), t)
+    client.sync()
+    for what, sequence in (("a repeated sequence", accepted), ("a sequence stepping back", accepted - 1)):
+        r = ownship(plan, t)
+        r.header = c.Header(c.PROTOCOL_VERSION, client.sender_id, sequence, round(t * 1e9))
+        expect_rejected(client, what, lambda: client.publishers["Ownship"].send_copy(r))
+    # Numbered on, the next one is accepted and echoed.
+    before = client.status
+    client.publish("Ownship", ownship(plan, t + 1.0), t + 1.0)
+    client.sync()
+    check(
+        client.status.messages_rejected == before.messages_rejected
+        and client.status.last_input_sequence == client.sequence,
+        "numbered on after them, a message is accepted and echoed",
+    )
+
+
+def expect_rejected(client: Client, what: str, send) -> None:
+    """Sends one bad message: rejected and counted, and nothing else moves (no plan, the
+    plan in flight kept, its sequence not echoed)."""
+    before = client.status
+    send()
     s = client.wait_for(lambda s: s.messages_rejected > before.messages_rejected)
     check(
-        s.messages_rejected == before.messages_rejected + 1
-        and s.plans_made == before.plans_made
+        s.messages_rejected == before.messages_rejected + 1,
+        f"{what}: rejected and counted",
+    )
+    check(
+        s.plans_made == before.plans_made
+        and s.current_plan_id == before.current_plan_id
         and s.last_input_sequence == before.last_input_sequence,
-        "a wrong protocol version: rejected and counted, its sequence not echoed",
+        f"{what}: no plan made, the plan in flight kept, its sequence not echoed",
     )
 
 
@@ -242,7 +257,7 @@ def main() -> int:
         )
 
         # 3. Bad inputs.
-        bad_inputs(client, 14.0)
+        bad_inputs(client, plan2, 14.0)
         check(planner.poll() is None, "the planner is alive after every bad input")
     finally:
         code = stop_planner(planner)

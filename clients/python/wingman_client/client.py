@@ -139,7 +139,10 @@ class Client:
 
     def sync(self, timeout_s: float = 60.0) -> list:
         """Lock-step barrier: notifies the planner and waits until its status echoes this
-        client's last sequence and it is not planning. Returns the plans that came."""
+        client's last sequence and it is not planning. Returns the plans that came. The
+        planner echoes only accepted messages: after one it rejects (`messages_rejected`
+        grows), wait with `wait_for` on that count instead."""
+        rejected = None if self.status is None else self.status.messages_rejected
         self.notify()
         new = []
         deadline = time.monotonic() + timeout_s
@@ -155,7 +158,9 @@ class Client:
             if time.monotonic() > deadline:
                 raise PlannerTimeout(
                     f"no echo of sequence {self.sequence} within {timeout_s} s "
-                    f"(last status: {None if s is None else s.last_input_sequence})"
+                    f"(last status: {None if s is None else s.last_input_sequence}; "
+                    f"messages rejected {rejected} before the barrier, "
+                    f"{None if s is None else s.messages_rejected} now)"
                 )
             self._wait()
 

@@ -97,7 +97,7 @@ PLANNER_STATE_DEGRADED = 2
 
 
 class Header(ctypes.Structure):
-    """Starts every message. A sender's `sequence` grows by one per message it publishes, one counter across all its services (so that the planner's status can echo the last input it processed); `mission_time_ns` is the sender's mission clock when it published."""
+    """Starts every message. A sender's `sequence` grows by one per message it publishes, one counter across all its services, so that the planner's status can echo the last input it accepted. On each input service the planner accepts a message only if its `sequence` is greater than the one of the sender's previous accepted message there and its `mission_time_ns` (the sender's mission clock when it published) not smaller: a repeat or a step back is rejected."""
 
     _fields_ = [
         ("protocol_version", ctypes.c_uint32),

@@ -223,7 +223,7 @@ pub struct World {
     movings: [Option<MovingTrack>; MAX_MOVING_THREATS],
     /// Mission time of the newest header, ns.
     pub now_ns: i64,
-    /// Highest header sequence processed.
+    /// Highest header sequence of an accepted input message.
     pub max_sequence: u64,
     /// Grows with every change of the threat world.
     pub epoch: u64,
@@ -263,16 +263,10 @@ impl World {
         }
     }
 
-    /// Records that a message with this header arrived on `input` (valid or not, as long
-    /// as its header speaks our protocol): its sequence is processed.
-    pub fn note_sequence(&mut self, header: &Header) {
-        if header.validate().is_ok() {
-            self.max_sequence = self.max_sequence.max(header.sequence);
-        }
-    }
-
-    /// Accepts a validated message's header: its mission clock must not go backwards on
-    /// its service. Advances the mission clock and the input's freshness.
+    /// Accepts a validated message's header: against the same sender's previous one on
+    /// this input, its sequence must grow and its mission clock must not go backwards.
+    /// Advances the mission clock, the input's freshness and the highest accepted
+    /// sequence; a refused header changes nothing.
     pub fn accept_header(
         &mut self,
         input: Input,
@@ -288,6 +282,7 @@ impl World {
         self.last_header[k] = Some(*header);
         self.last_seen[k] = Some(wall);
         self.now_ns = self.now_ns.max(header.mission_time_ns);
+        self.max_sequence = self.max_sequence.max(header.sequence);
         Ok(())
     }
 

@@ -188,7 +188,9 @@ impl FakeHarness {
         }
     }
 
-    /// Waits until the planner has processed every input sent and is not planning.
+    /// Waits until the planner has accepted the last input sent (its status echoes the
+    /// sequence) and is not planning. A rejected last input is never echoed: wait on
+    /// `messages_rejected` for it instead.
     pub fn wait_processed(&mut self, timeout: Duration) -> bool {
         let seq = self.sequence;
         self.wait_until(timeout, |h| {

@@ -61,11 +61,11 @@ impl MessageLoop {
         self.counters.received - before
     }
 
-    /// Counts a sample and validates it; an invalid one is counted, logged once per input
-    /// and kind, and changes nothing.
+    /// Counts a sample and validates it, its header against the sender's previous one on
+    /// this input included; an invalid one is counted, logged once per input and kind, and
+    /// changes nothing else (its sequence is not echoed).
     fn admit<M: Message>(&mut self, input: Input, msg: &M) -> bool {
         self.counters.received += 1;
-        self.world.note_sequence(msg.header());
         let wall = self.clock.now();
         let checked = msg
             .validate()
@@ -251,7 +251,7 @@ impl MessageLoop {
 }
 
 /// Kinds of [`ValidationError`] ([`rejection_index`] maps each to one below this).
-const REJECTION_KINDS: usize = 7;
+const REJECTION_KINDS: usize = 8;
 
 /// Index of a validation error's kind (for logging once per kind), below
 /// [`REJECTION_KINDS`]. The match is exhaustive: a new kind fails to compile here.
@@ -264,5 +264,6 @@ fn rejection_index(e: &ValidationError) -> usize {
         ValidationError::UnknownEnum { .. } => 4,
         ValidationError::TimeBackwards { .. } => 5,
         ValidationError::OutOfRange { .. } => 6,
+        ValidationError::SequenceNotIncreasing { .. } => 7,
     }
 }
