@@ -69,10 +69,11 @@ fn a_tasking_gives_a_plan_and_bad_or_clear_inputs_change_nothing() {
     assert_eq!(s.messages_rejected, 0);
     assert!(s.last_plan_compute_ms > 0.0);
 
-    // Rejected: an invalid threat report (NaN centre), a message of another protocol
-    // version, and two valid reports whose sequence does not grow on the threats input
-    // (a repeat of the last accepted one's, a step back). Nothing but the count moves:
-    // the status keeps echoing the sequence before them.
+    // Rejected: an invalid threat report (NaN centre) numbered 10^15, a message of
+    // another protocol version, and two valid reports whose sequence does not grow on the
+    // threats input (a repeat of the last accepted one's, a step back). Nothing but the
+    // count moves: the status keeps echoing the sequence before them (it used to echo the
+    // invalid report's 10^15, which every later lock-step barrier then passed at once).
     let echoed = s.last_input_sequence;
     // `first_plan` sent the scenario's threats, then the tasking.
     let last_threat = h.sequence - 1;
@@ -80,6 +81,7 @@ fn a_tasking_gives_a_plan_and_bad_or_clear_inputs_change_nothing() {
     let mut bad = static_threat(50, [10000.0, 10000.0, 0.0], [1000.0, 1000.0, 0.0]);
     bad.header = h.header();
     bad.center_m[0] = f64::NAN;
+    bad.header.sequence = 1_000_000_000_000_000;
     h.send_threat_raw(bad);
     let mut foreign = static_threat(51, [10000.0, 10000.0, 0.0], [1000.0, 1000.0, 0.0]);
     foreign.header = h.header();

@@ -185,6 +185,10 @@ def bad_inputs(client: Client, plan, t: float) -> None:
     o = ownship(None, t)
     o.header = c.Header(c.PROTOCOL_VERSION + 1, client.sender_id, client.sequence + 1, round(t * 1e9))
     expect_rejected(client, "a wrong protocol version", lambda: client.publishers["Ownship"].send_copy(o))
+    huge = ownship(plan, t)
+    huge.state[0] = float("nan")
+    huge.header = c.Header(c.PROTOCOL_VERSION, client.sender_id, 10**15, round(t * 1e9))
+    expect_rejected(client, "a NaN numbered 10^15", lambda: client.publishers["Ownship"].send_copy(huge))
     accepted = client.publish("Ownship", ownship(plan, t), t)
     client.sync()
     for what, sequence in (("a repeated sequence", accepted), ("a sequence stepping back", accepted - 1)):

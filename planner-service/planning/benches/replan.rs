@@ -226,7 +226,7 @@ fn main() {
         let first = yardstick
             .plan(&take_off, &settings, Deadline::after(clock, LONG))
             .unwrap();
-        let flying = FlyingPlan::new(&take_off, first.trajectory);
+        let flying = FlyingPlan::new(&take_off, first.trajectory).with_solution(first.solution);
         let (t_start, tf) = (take_off.t0, flying.path.final_time().unwrap());
         for share in WHEN {
             let t_c = t_start + share * (tf - t_start);

@@ -19,7 +19,7 @@ mod warm_start;
 
 use nlp_stage::{Finaled, NlpStage, Ranked, Solved};
 pub use settings::{MeshSettings, PlannerSettings, PlannerSettingsError};
-pub use warm_start::{FlyingPlan, WarmReport};
+pub use warm_start::{FlyingPlan, PlanSolution, WarmReport};
 
 use std::sync::Arc;
 use std::time::Duration;
@@ -105,6 +105,10 @@ pub struct PlanOutcome {
     pub warm: Option<WarmReport>,
     /// From the plan's start to its first `Optimal` solution (`None`: it has none).
     pub first_optimal: Option<Duration>,
+    /// The NLP solution the plan was exported from, primal and dual, when its solve
+    /// converged: a re-plan of the rest of its mission starts from it
+    /// ([`FlyingPlan::with_solution`]).
+    pub solution: Option<Arc<PlanSolution>>,
 }
 
 /// The planner with its reusable workspace.

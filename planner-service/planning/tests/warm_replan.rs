@@ -12,15 +12,15 @@ use wingman_planning::problem::{Problem, Threats};
 use wingman_planning::threat::Superquadric;
 
 mod common;
-use common::{clock, planned};
+use common::{clock, planned_outcome};
 
 const LONG: Duration = Duration::from_secs(60);
 
 /// The re-plan problem of `take_off` at share `at` of its plan, `cross_m` to the left of
 /// the plan, and the plan in flight.
 fn event(name: &str, at: f64, cross_m: f64) -> (Problem, FlyingPlan) {
-    let (take_off, path) = planned(name);
-    let flying = FlyingPlan::new(&take_off, path);
+    let (take_off, plan) = planned_outcome(name);
+    let flying = FlyingPlan::new(&take_off, plan.trajectory).with_solution(plan.solution);
     let tf = flying.path.final_time().unwrap();
     let t_c = take_off.t0 + at * (tf - take_off.t0);
     let (x, _) = flying.path.at(t_c).unwrap();
@@ -110,4 +110,44 @@ fn the_same_re_plan_twice_is_the_same_plan() {
     assert_eq!(a.path, b.path);
     assert_eq!(a.trajectory, b.trajectory);
     assert_eq!(a.cost.to_bits(), b.cost.to_bits());
+}
+
+#[test]
+fn the_plans_multipliers_shorten_its_warm_solve() {
+    // The plain solve of the plan in flight (no new threat across it) takes the plan's
+    // multipliers at the same mission time (`warm::transfer_in_time`): fewer iterations
+    // than from the primal path alone (measured: 3 against 8-11 on the working mesh in
+    // 2-D, 1-6 against 7-16 in 3-D), to the same solution (dense costs within 1e-6).
+    for name in [
+        "2d-min-time-avoidable",
+        "3d-fixed-time-avoidable",
+        "3d-min-time-rendezvous-avoidable",
+    ] {
+        for (at, cross_m) in [(0.2, 0.0), (0.4, 600.0)] {
+            let (p, flying) = event(name, at, cross_m);
+            assert!(
+                flying.solution.is_some(),
+                "{name}: a converged take-off plan"
+            );
+            let primal = FlyingPlan {
+                solution: None,
+                ..flying.clone()
+            };
+            let iterations = |f: &FlyingPlan| {
+                let out = replan(&p, f);
+                let warm = out.warm.expect("the problem continues the plan");
+                (warm.nlp.iterations.iter().sum::<usize>(), warm.cost)
+            };
+            let (with, with_cost) = iterations(&flying);
+            let (without, without_cost) = iterations(&primal);
+            assert!(
+                with < without,
+                "{name} at {at}: {with} against {without} iterations"
+            );
+            assert!(
+                (with_cost - without_cost).abs() <= 1e-6 * without_cost.abs().max(1.0),
+                "{name} at {at}: {with_cost} against {without_cost}"
+            );
+        }
+    }
 }

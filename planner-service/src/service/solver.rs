@@ -313,7 +313,7 @@ fn solve_loop(
         if let Ok(o) = &outcome {
             last = Some((
                 ticket.plan_id,
-                FlyingPlan::new(&problem, o.trajectory.clone()),
+                FlyingPlan::new(&problem, o.trajectory.clone()).with_solution(o.solution.clone()),
             ));
         }
         let result = SolveResult {

@@ -1,6 +1,9 @@
 //! Warm start on a new mesh: the multipliers of a solution on one mesh carried to another
 //! (a finer uniform mesh, or a refined one), so that the solve there starts primal-dual
 //! and re-converges in a few iterations instead of re-learning its multipliers from zero.
+//! The same carries a plan's multipliers into a re-plan of what is left of its mission
+//! ([`transfer_in_time`]): the costates are those of the rest of the mission (Bellman), so
+//! they are taken at the same mission time instead of the same phase fraction.
 //!
 //! On an LGR mesh the multiplier of a node's defect is the costate at the node times the
 //! node's quadrature weight `w_i` (on `[-1, 1]`): with the defect `D X - half · Δ · f` and the
@@ -49,6 +52,50 @@ pub fn transfer(
     to: &Transcription,
     out: &mut PrimalDual,
 ) -> bool {
+    transfer_mapped(from, duals, to, out, |_, s| s)
+}
+
+/// The multipliers for a warm start of `to`, a re-plan from a later start, from the
+/// solution `duals` of the plan `from` it continues, with the same phases: a node of `to`
+/// takes `from`'s multiplier densities at its mission time (by the phase times of `to`'s
+/// starting point `out.x` and of `from`'s solution), clamped to `from`'s phase. As
+/// [`transfer`] otherwise; `false` also when the phase counts differ (a target passed).
+pub fn transfer_in_time(
+    from: &Transcription,
+    duals: &PrimalDual,
+    to: &Transcription,
+    out: &mut PrimalDual,
+) -> bool {
+    let phases = to.layout.phases();
+    if from.layout.phases() != phases
+        || out.x.len() != to.n_vars()
+        || duals.x.len() != from.n_vars()
+    {
+        return false;
+    }
+    let times = |tr: &Transcription, x: &[f64]| -> Vec<(f64, f64)> {
+        let end = |p: usize| x[tr.time(p)] * tr.scale[tr.time(p)];
+        (0..phases)
+            .map(|p| (if p == 0 { tr.problem.t0 } else { end(p - 1) }, end(p)))
+            .collect()
+    };
+    let (old, new) = (times(from, &duals.x), times(to, &out.x));
+    let to_old = |p: usize, s: f64| {
+        let t = new[p].0 + s * (new[p].1 - new[p].0);
+        ((t - old[p].0) / (old[p].1 - old[p].0).max(1e-9)).clamp(0.0, 1.0)
+    };
+    transfer_mapped(from, duals, to, out, to_old)
+}
+
+/// [`transfer`] with `to`'s node at phase fraction `s` of phase `p` taking `from`'s
+/// densities at phase fraction `map(p, s)` of the same phase.
+fn transfer_mapped(
+    from: &Transcription,
+    duals: &PrimalDual,
+    to: &Transcription,
+    out: &mut PrimalDual,
+    map: impl Fn(usize, f64) -> f64,
+) -> bool {
     let (nx, nu) = (from.nx, from.nu);
     let (n_from, n_to) = (from.n_vars(), to.n_vars());
     let (m_from, m_to) = (from.n_cons(), to.n_cons());
@@ -89,7 +136,7 @@ pub fn transfer(
     // Defect rows and control bounds at the new collocation nodes.
     for k in 0..k_to {
         let node = to.layout.nodes[k];
-        let (a, b, f) = bracket(from, node.phase, node.s);
+        let (a, b, f) = bracket(from, node.phase, map(node.phase, node.s));
         let w = weight(to, k);
         for c in 0..nx {
             let d = (1.0 - f) * lambda_density(a, c) + f * lambda_density(b, c);
@@ -116,7 +163,7 @@ pub fn transfer(
                     f64::from(u8::from(free)) * z_from[j] / from.scale[j] * obj_ratio * to.scale[i]
                 } else {
                     let node = to.layout.nodes[k];
-                    let (a, b, f) = bracket(from, node.phase, node.s);
+                    let (a, b, f) = bracket(from, node.phase, map(node.phase, node.s));
                     let (ia, ib) = (from.state(a, c), from.state(b, c));
                     let d =
                         (1.0 - f) * bound_density(z_from, ia, a) + f * bound_density(z_from, ib, b);

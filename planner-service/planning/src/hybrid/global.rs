@@ -9,8 +9,8 @@ use wingman_interfaces::Quality;
 use super::nlp_stage::{self, NlpStage};
 use super::timing::{Ranking, Seen, SolveTiming, StageTiming};
 use super::{
-    Gathered, PlanError, PlanOutcome, PlanPath, Planner, PlannerSettings, StageTimes, gather,
-    ranking_meshes, reference_export, schedule, trajectory_cost,
+    Gathered, PlanError, PlanOutcome, PlanPath, PlanSolution, Planner, PlannerSettings, StageTimes,
+    gather, ranking_meshes, reference_export, schedule, trajectory_cost,
 };
 use crate::basins;
 use crate::clock::Deadline;
@@ -100,6 +100,7 @@ impl Planner {
             coarse: &coarse,
             fallback_start: &sw.best,
             reference: reference_export(settings),
+            fallback_warm: None,
             timing,
             seen: Seen::default(),
             deadline,
@@ -177,6 +178,7 @@ impl Planner {
             swarm_iterations: sw.iterations,
             nlp: report,
             times,
+            solution: accepted.and_then(|(a, _)| PlanSolution::of(a)),
         })
     }
 

@@ -10,9 +10,12 @@ use wingman_interfaces::Quality;
 
 use super::schedule;
 use super::timing::{Seen, SolveTiming};
-use super::{PlanError, PlannerSettings, finalists, phase_durations, trajectory_cost};
+use super::{
+    PlanError, PlanSolution, PlannerSettings, finalists, phase_durations, trajectory_cost,
+};
 use crate::clock::Deadline;
 use crate::collocation::kkt::KktCache;
+use crate::collocation::warm;
 use crate::collocation::{
     ExportSettings, Mesh, NlpSettings, NlpStatus, PrimalDual, SolveBudget, Transcription, export,
     interval_errors, refine, solve, split_crossings,
@@ -46,6 +49,9 @@ pub(super) struct MeshSolve<'a> {
     pub(super) feasibility_tol: f64,
     /// The previous mesh's transcription and primal-dual solution, to start from.
     pub(super) warm_from: Option<(&'a Transcription, &'a PrimalDual)>,
+    /// `warm_from` is the plan in flight (its multipliers are taken at the same mission
+    /// time, `warm::transfer_in_time`), not a solution of this problem on another mesh.
+    pub(super) warm_in_time: bool,
     /// The first barrier parameter, over `nlp_settings`' (`None`: theirs).
     pub(super) mu_init: Option<f64>,
     /// The primal starting point itself (scaled), when it is a solution on this very mesh
@@ -73,6 +79,7 @@ pub(super) fn solve_on_mesh(
         refined,
         feasibility_tol,
         warm_from,
+        warm_in_time,
         mu_init,
         start_x,
         cancel,
@@ -102,12 +109,15 @@ pub(super) fn solve_on_mesh(
     if mu_init.is_some() {
         nlp.mu_init = mu_init;
     }
-    let mut start = PrimalDual::default();
+    let mut start = PrimalDual {
+        x,
+        ..PrimalDual::default()
+    };
     let warm = match warm_from {
-        Some((from, duals)) => crate::collocation::warm::transfer(from, duals, &tr, &mut start),
+        Some((from, duals)) if warm_in_time => warm::transfer_in_time(from, duals, &tr, &mut start),
+        Some((from, duals)) => warm::transfer(from, duals, &tr, &mut start),
         None => false,
     };
-    start.x = x;
     let vars = tr.n_vars();
     let budget = SolveBudget {
         deadline,
@@ -165,6 +175,7 @@ pub(super) fn floor(
         refined: false,
         feasibility_tol: settings.nlp.feasibility_tol,
         warm_from: None,
+        warm_in_time: false,
         mu_init: ranking_mu_init(problem, settings),
         start_x: None,
         cancel: None,
@@ -220,6 +231,9 @@ pub(super) struct NlpStage<'a> {
     /// The guess of the candidate solved when no start ranked: the swarm's best, or on
     /// the warm path the plan in flight cut at the start.
     pub(super) fallback_start: &'a Trajectory,
+    /// The plan in flight's solution that the fallback candidate's solve takes its
+    /// multipliers from (the warm path's plain solve; `warm::transfer_in_time`).
+    pub(super) fallback_warm: Option<&'a PlanSolution>,
     /// How ranked solutions are exported: densely, open loop.
     pub(super) reference: ExportSettings,
     /// The solves' timing learned from recent plans.
@@ -291,6 +305,7 @@ impl NlpStage<'_> {
                 refined: true,
                 feasibility_tol: settings.nlp.feasibility_tol,
                 warm_from: warm_start_of(Some(current), settings.warm_mesh_changes),
+                warm_in_time: false,
                 mu_init: None,
                 start_x: same.then_some(current.x.as_slice()),
                 cancel,
@@ -322,6 +337,7 @@ impl schedule::Stage for NlpStage<'_> {
                 refined: false,
                 feasibility_tol: settings.ranking_feasibility_tol,
                 warm_from: None,
+                warm_in_time: false,
                 mu_init: ranking_mu_init(problem, settings),
                 start_x: None,
                 cancel: None,
@@ -350,11 +366,21 @@ impl schedule::Stage for NlpStage<'_> {
 
     fn finalist(&self, c: usize, rank: Option<&Ranked>, cancel: Arc<AtomicBool>) -> Finaled {
         let settings = self.settings;
-        // A finalist starts from its coarse solution; the fallback from its own start.
-        let (guess, coarse) = match rank.and_then(|r| r.path.as_ref().map(|p| (&p.1, r))) {
-            Some((path, r)) => (path, accepted_of(&r.result)),
-            None => (self.fallback_start, None),
-        };
+        // A finalist starts from its coarse solution; the fallback from its own start, with
+        // the plan in flight's multipliers if it has them.
+        let (guess, warm_from, warm_in_time) =
+            match rank.and_then(|r| r.path.as_ref().map(|p| (&p.1, r))) {
+                Some((path, r)) => (
+                    path,
+                    warm_start_of(accepted_of(&r.result), settings.warm_mesh_changes),
+                    false,
+                ),
+                None => (
+                    self.fallback_start,
+                    self.fallback_warm.map(|s| (&s.tr, &s.duals)),
+                    true,
+                ),
+            };
         let mut mesh = Mesh::uniform(
             settings.mesh.points,
             &phase_durations(self.problem.t0, guess),
@@ -377,7 +403,8 @@ impl schedule::Stage for NlpStage<'_> {
                 nlp_settings: &settings.finalist_nlp,
                 refined: true,
                 feasibility_tol: settings.nlp.feasibility_tol,
-                warm_from: warm_start_of(coarse, settings.warm_mesh_changes),
+                warm_from,
+                warm_in_time,
                 mu_init: None,
                 start_x: None,
                 cancel: Some(cancel),

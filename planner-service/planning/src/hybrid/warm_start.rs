@@ -4,12 +4,13 @@
 //! of the same tasking solves from it first; the global search follows with the time left
 //! (see [`super::Planner::replan`]).
 
+use std::sync::Arc;
 use std::time::Duration;
 
 use wingman_interfaces::{Model, Objective, Quality};
 
 use super::deflect;
-use super::nlp_stage::NlpStage;
+use super::nlp_stage::{NlpStage, Solved};
 use super::timing::Seen;
 use super::{
     Gathered, NlpReport, PlanError, PlanOutcome, PlanPath, Planner, PlannerSettings, StageTimes,
@@ -17,8 +18,8 @@ use super::{
 };
 use crate::basins;
 use crate::clock::Deadline;
-use crate::collocation::export;
 use crate::collocation::transcription::nearest_turn;
+use crate::collocation::{PrimalDual, Transcription, export};
 use crate::cuts::Work;
 use crate::problem::{Problem, Threats};
 use crate::seeding;
@@ -44,6 +45,23 @@ pub struct WarmReport {
 pub(super) struct WarmPlan {
     report: WarmReport,
     trajectory: Option<Trajectory>,
+    solution: Option<Arc<PlanSolution>>,
+}
+
+/// A plan's NLP solution on its last mesh, primal and dual (a converged solve's): the
+/// multipliers a re-plan of the rest of its mission starts from.
+#[derive(Debug)]
+pub struct PlanSolution {
+    pub(super) tr: Transcription,
+    pub(super) duals: PrimalDual,
+}
+
+impl PlanSolution {
+    /// The solution of an accepted solve, if it converged (its multipliers are known).
+    pub(super) fn of(solved: Solved) -> Option<Arc<PlanSolution>> {
+        let Solved { tr, warm, .. } = solved;
+        warm.map(|duals| Arc::new(PlanSolution { tr, duals }))
+    }
 }
 
 impl Planner {
@@ -84,6 +102,9 @@ impl Planner {
             starts: &starts,
             coarse: &coarse,
             fallback_start: &guess,
+            // The plain solve of the plan in flight takes its multipliers too; the starts
+            // bent around a new threat are other paths.
+            fallback_warm: flying.solution.as_deref().filter(|_| starts.is_empty()),
             reference: reference_export(settings),
             timing: self.timing[model],
             seen: Seen::default(),
@@ -112,9 +133,13 @@ impl Planner {
         let cost = trajectory
             .as_ref()
             .map_or(f64::INFINITY, |t| trajectory_cost(problem, t));
+        let quality = trajectory
+            .as_ref()
+            .and(accepted.as_ref().map(|(a, _)| a.quality));
         Ok(WarmPlan {
+            solution: accepted.and_then(|(a, _)| PlanSolution::of(a)),
             report: WarmReport {
-                quality: trajectory.as_ref().and(accepted.map(|(a, _)| a.quality)),
+                quality,
                 cost,
                 nlp: report,
                 first_optimal: first_optimal.map(|t| t.saturating_sub(started)),
@@ -167,7 +192,11 @@ impl WarmPlan {
 impl PlanOutcome {
     /// The warm path's plan alone (no global search ran: no swarm path, no swarm time).
     pub(super) fn of_warm(warm: WarmPlan) -> PlanOutcome {
-        let WarmPlan { report, trajectory } = warm;
+        let WarmPlan {
+            report,
+            trajectory,
+            solution,
+        } = warm;
         PlanOutcome {
             quality: report.quality.unwrap_or(Quality::SwarmOnly),
             trajectory: trajectory.unwrap_or_default(),
@@ -183,6 +212,7 @@ impl PlanOutcome {
             path: PlanPath::Warm,
             first_optimal: report.first_optimal,
             warm: Some(report),
+            solution,
         }
     }
 
@@ -190,7 +220,11 @@ impl PlanOutcome {
     /// followed it): a solution of the NLP against the swarm's path, else the lower cost
     /// (a tie to the warm path). The warm path's report is kept either way.
     pub(super) fn offer(&mut self, warm: WarmPlan) {
-        let WarmPlan { report, trajectory } = warm;
+        let WarmPlan {
+            report,
+            trajectory,
+            solution,
+        } = warm;
         self.times.warm = report.elapsed;
         // The global search started after the warm path.
         self.first_optimal = self.first_optimal.map(|t| t + report.elapsed);
@@ -205,6 +239,7 @@ impl PlanOutcome {
                 self.cost = report.cost;
                 self.trajectory = trajectory;
                 self.nlp = report.nlp.clone();
+                self.solution = solution;
                 true
             }
             _ => false,
@@ -231,6 +266,10 @@ pub struct FlyingPlan {
     pub threats: Threats,
     /// The plan's samples; its `phase_ends` are those of `targets` and the final time.
     pub path: Trajectory,
+    /// The NLP solution the plan was exported from, if kept: a re-plan's plain solve of
+    /// the plan takes its multipliers (at the same mission time) when no target was passed
+    /// in between (the same phases).
+    pub solution: Option<Arc<PlanSolution>>,
 }
 
 impl FlyingPlan {
@@ -244,7 +283,13 @@ impl FlyingPlan {
             final_time: problem.final_time,
             threats: problem.threats.clone(),
             path,
+            solution: None,
         }
+    }
+
+    /// This plan with the NLP solution it was exported from (`PlanOutcome::solution`).
+    pub fn with_solution(self, solution: Option<Arc<PlanSolution>>) -> FlyingPlan {
+        FlyingPlan { solution, ..self }
     }
 
     /// How many of this plan's targets `problem` leaves out as passed, if `problem`

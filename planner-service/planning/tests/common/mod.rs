@@ -9,7 +9,7 @@ use std::time::Duration;
 use wingman_planning::clock::{Deadline, MonotonicClock};
 use wingman_planning::collocation::{Mesh, Transcription, TranscriptionSettings};
 use wingman_planning::estimation::{Estimate, GaussMarkov, MovingThreat, Road};
-use wingman_planning::hybrid::{Planner, PlannerSettings};
+use wingman_planning::hybrid::{PlanOutcome, Planner, PlannerSettings};
 use wingman_planning::problem::Problem;
 use wingman_planning::scenario::bundled;
 use wingman_planning::threat::{Superquadric, ThreatLayout};
@@ -22,6 +22,12 @@ pub fn clock() -> &'static MonotonicClock {
 
 /// The problem of bundled scenario `name` and the planner's trajectory for it.
 pub fn planned(name: &str) -> (Problem, Trajectory) {
+    let (p, plan) = planned_outcome(name);
+    (p, plan.trajectory)
+}
+
+/// The problem of bundled scenario `name` and the planner's plan for it.
+pub fn planned_outcome(name: &str) -> (Problem, PlanOutcome) {
     let p = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
     let settings = PlannerSettings::default();
     let plan = Planner::new(&settings)
@@ -31,7 +37,7 @@ pub fn planned(name: &str) -> (Problem, Trajectory) {
             Deadline::after(clock(), Duration::from_secs(60)),
         )
         .unwrap();
-    (p, plan.trajectory)
+    (p, plan)
 }
 
 /// The transcription of `p` on `mesh` around `guess`, with the guess as its scaled initial
