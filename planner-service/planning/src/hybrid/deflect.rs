@@ -55,6 +55,38 @@ pub(super) fn deflected(problem: &Problem, known: &Threats, guess: &Trajectory) 
         .collect()
 }
 
+/// Whether `guess` comes within `F < near` of a threat of `problem` that `known` (the plan
+/// in flight's threats) lacks: the world changed around the plan.
+pub(super) fn near_new_threat(
+    problem: &Problem,
+    known: &Threats,
+    guess: &Trajectory,
+    near: f64,
+) -> bool {
+    fn any_near<const D: usize>(
+        threats: &[Superquadric<D>],
+        known: &[Superquadric<D>],
+        guess: &Trajectory,
+        near: f64,
+    ) -> bool {
+        threats.iter().filter(|t| !known.contains(t)).any(|t| {
+            guess.states.iter().any(|s| {
+                let p: [f64; D] = std::array::from_fn(|i| s[i]);
+                t.f(&p) < near
+            })
+        })
+    }
+    match (&problem.threats, known) {
+        (Threats::Planar { layout, .. }, Threats::Planar { layout: old, .. }) => {
+            any_near(layout.threats(), old.threats(), guess, near)
+        }
+        (Threats::Spatial { layout, .. }, Threats::Spatial { layout: old, .. }) => {
+            any_near(layout.threats(), old.threats(), guess, near)
+        }
+        _ => true,
+    }
+}
+
 /// The crossings of `guess` through threats of `threats` not among `known`.
 fn new_crossings<const D: usize>(
     threats: &[Superquadric<D>],
@@ -196,6 +228,26 @@ mod tests {
         let mut p = Problem::from_scenario(&sc).expect("valid");
         p.threats = threats(list);
         p
+    }
+
+    #[test]
+    fn a_new_threat_is_near_the_path_within_the_given_f() {
+        // A 4 km circle whose edge is 1 km from the path (F = (5/4)^2 = 1.5625 there).
+        let beside = Superquadric::ellipsoid([20_000.0, 5000.0], [4000.0, 4000.0]).expect("valid");
+        let guess = east();
+        let p = problem_with(&[beside]);
+        assert!(near_new_threat(&p, &threats(&[]), &guess, 2.0));
+        assert!(!near_new_threat(&p, &threats(&[]), &guess, 1.5));
+        // Known to the plan: not new.
+        assert!(!near_new_threat(&p, &threats(&[beside]), &guess, 2.0));
+        // Far: 20 km to the side.
+        let far = Superquadric::ellipsoid([20_000.0, 20_000.0], [4000.0, 4000.0]).expect("valid");
+        assert!(!near_new_threat(
+            &problem_with(&[far]),
+            &threats(&[]),
+            &guess,
+            2.0
+        ));
     }
 
     #[test]

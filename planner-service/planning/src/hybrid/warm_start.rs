@@ -64,6 +64,10 @@ impl PlanSolution {
     }
 }
 
+/// A new threat whose `F` along the plan in flight falls below this (about 1.4 of an
+/// ellipsoid's half-extents) is near the plan: its multipliers are not carried over.
+const NEAR_NEW_F: f64 = 2.0;
+
 impl Planner {
     /// The warm path: `guess` (the plan in flight cut at the start) solved on the working
     /// mesh and refined, as a finalist is, on the calling thread. When `guess` crosses
@@ -87,6 +91,7 @@ impl Planner {
         let started = clock.now();
         let model = usize::from(problem.dim() == 3);
         let bends = deflect::deflected(problem, &flying.threats, &guess);
+        let near_new = deflect::near_new_threat(problem, &flying.threats, &guess, NEAR_NEW_F);
         let starts: Vec<Trajectory> = if bends.is_empty() {
             Vec::new()
         } else {
@@ -102,9 +107,14 @@ impl Planner {
             starts: &starts,
             coarse: &coarse,
             fallback_start: &guess,
-            // The plain solve of the plan in flight takes its multipliers too; the starts
-            // bent around a new threat are other paths.
-            fallback_warm: flying.solution.as_deref().filter(|_| starts.is_empty()),
+            // The plain solve of the plan in flight takes its multipliers too, unless a new
+            // threat has come near it (they are the costates of the old world: from them a
+            // 3-D solve past a new threat did not converge in 100 ms, from the path alone
+            // it did).
+            fallback_warm: flying
+                .solution
+                .as_deref()
+                .filter(|_| starts.is_empty() && !near_new),
             reference: reference_export(settings),
             timing: self.timing[model],
             seen: Seen::default(),
