@@ -57,6 +57,11 @@ impl FakeHarness {
         }
     }
 
+    /// The input publishers (for messages sent as they are).
+    pub fn inputs(&self) -> &ipc::InputPublishers {
+        &self.ports.inputs
+    }
+
     /// The next input header.
     pub fn header(&mut self) -> Header {
         self.sequence += 1;
