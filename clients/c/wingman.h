@@ -1,4 +1,4 @@
-/* wingman.h: the wingman planner's message contract for C and C++ (protocol 2).
+/* wingman.h: the wingman planner's message contract for C and C++ (protocol 3).
  * Generated from the Rust code (`WINGMAN_BLESS=1 cargo test -p wingman-ipc --test
  * contract`); do not edit. Layouts are little-endian, `#[repr(C)]`, with no implicit
  * padding; docs/INTERFACES.md says what each field means. */
@@ -17,7 +17,7 @@
 #endif
 
 /* Constants */
-#define WINGMAN_PROTOCOL_VERSION 2
+#define WINGMAN_PROTOCOL_VERSION 3
 #define WINGMAN_MAX_TARGETS 8
 #define WINGMAN_MAX_PHASES 9
 #define WINGMAN_MAX_ROUTE_POINTS 16
@@ -411,6 +411,7 @@ typedef struct wingman_PlannerStatus {
     uint64_t current_plan_id; /* `plan_id` of the newest published plan (0: none). */
     uint64_t messages_received; /* Messages taken from every input service. */
     uint64_t messages_rejected; /* Messages rejected and dropped: failed `validate()`, or a header that does not follow the sender's previous one on its service. */
+    uint64_t messages_lost; /* Messages lost before the planner read them (a subscriber buffer overflowed): the gaps in each sender's `sequence`, counted one pass after a later one is read. */
     uint64_t plans_made; /* Plans published. */
     uint64_t triggers_coalesced; /* Triggers folded into a plan already pending. */
     uint64_t triggers_deferred; /* Triggers held back by the minimum spacing or the duty-cycle cap. */
@@ -422,7 +423,7 @@ typedef struct wingman_PlannerStatus {
 #endif
 } wingman_PlannerStatus;
 #define WINGMAN_PLANNER_STATUS_TYPE_NAME "wingman::PlannerStatus"
-WINGMAN_STATIC_ASSERT(sizeof(wingman_PlannerStatus) == 112, "size of wingman_PlannerStatus");
+WINGMAN_STATIC_ASSERT(sizeof(wingman_PlannerStatus) == 120, "size of wingman_PlannerStatus");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_PlannerStatus) == 8, "alignment of wingman_PlannerStatus");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, header) == 0, "offset of wingman_PlannerStatus.header");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, state) == 24, "offset of wingman_PlannerStatus.state");
@@ -431,11 +432,12 @@ WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, last_input_sequence) == 32
 WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, current_plan_id) == 40, "offset of wingman_PlannerStatus.current_plan_id");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, messages_received) == 48, "offset of wingman_PlannerStatus.messages_received");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, messages_rejected) == 56, "offset of wingman_PlannerStatus.messages_rejected");
-WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, plans_made) == 64, "offset of wingman_PlannerStatus.plans_made");
-WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, triggers_coalesced) == 72, "offset of wingman_PlannerStatus.triggers_coalesced");
-WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, triggers_deferred) == 80, "offset of wingman_PlannerStatus.triggers_deferred");
-WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, popups_clear) == 88, "offset of wingman_PlannerStatus.popups_clear");
-WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, last_plan_compute_ms) == 96, "offset of wingman_PlannerStatus.last_plan_compute_ms");
-WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, budget_remaining_ms) == 104, "offset of wingman_PlannerStatus.budget_remaining_ms");
+WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, messages_lost) == 64, "offset of wingman_PlannerStatus.messages_lost");
+WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, plans_made) == 72, "offset of wingman_PlannerStatus.plans_made");
+WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, triggers_coalesced) == 80, "offset of wingman_PlannerStatus.triggers_coalesced");
+WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, triggers_deferred) == 88, "offset of wingman_PlannerStatus.triggers_deferred");
+WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, popups_clear) == 96, "offset of wingman_PlannerStatus.popups_clear");
+WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, last_plan_compute_ms) == 104, "offset of wingman_PlannerStatus.last_plan_compute_ms");
+WINGMAN_STATIC_ASSERT(offsetof(wingman_PlannerStatus, budget_remaining_ms) == 112, "offset of wingman_PlannerStatus.budget_remaining_ms");
 
 #endif /* WINGMAN_H */

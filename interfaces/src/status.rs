@@ -31,6 +31,9 @@ wire_struct! {
         /// Messages rejected and dropped: failed `validate()`, or a header that does not
         /// follow the sender's previous one on its service.
         pub messages_rejected: u64 ["-"],
+        /// Messages lost before the planner read them (a subscriber buffer overflowed):
+        /// the gaps in each sender's `sequence`, counted one pass after a later one is read.
+        pub messages_lost: u64 ["-"],
         /// Plans published.
         pub plans_made: u64 ["-"],
         /// Triggers folded into a plan already pending.

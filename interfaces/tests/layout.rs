@@ -204,7 +204,7 @@ fn plan_layout() {
 #[test]
 fn status_layout() {
     pin::<PlannerStatus>(
-        112,
+        120,
         8,
         &[
             ("header", 0),
@@ -214,12 +214,13 @@ fn status_layout() {
             ("current_plan_id", 40),
             ("messages_received", 48),
             ("messages_rejected", 56),
-            ("plans_made", 64),
-            ("triggers_coalesced", 72),
-            ("triggers_deferred", 80),
-            ("popups_clear", 88),
-            ("last_plan_compute_ms", 96),
-            ("budget_remaining_ms", 104),
+            ("messages_lost", 64),
+            ("plans_made", 72),
+            ("triggers_coalesced", 80),
+            ("triggers_deferred", 88),
+            ("popups_clear", 96),
+            ("last_plan_compute_ms", 104),
+            ("budget_remaining_ms", 112),
         ],
     );
 }

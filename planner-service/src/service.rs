@@ -26,6 +26,7 @@ pub mod budget;
 pub mod message_loop;
 pub mod run;
 pub mod sched;
+pub mod sequence_gaps;
 pub mod solver;
 pub mod thread;
 pub mod triggers;

@@ -219,3 +219,54 @@ fn a_burst_of_popups_is_coalesced_into_few_plans() {
     );
     service.stop(|| h.wake()).expect("the service stops");
 }
+
+#[test]
+fn a_burst_over_a_buffer_is_counted_as_lost_and_none_is_at_the_documented_rate() {
+    let (service, mut h) = first_plan("loss");
+    let plan = h.plans[0].clone();
+    let on_plan = |t: f64| {
+        let s = state_at(&plan, t).unwrap();
+        ownship_2d(t, plan.plan_id, [s[0], s[1], s[2]])
+    };
+    let mut t = 1.0;
+    // The documented rate: at most a subscriber buffer's worth of messages per service
+    // between two notifications (ownship states 4, threat reports 64: here 4 of each).
+    for round in 0..3 {
+        for k in 0..4 {
+            h.set_time(t);
+            h.send_ownship(on_plan(t));
+            h.send_threat(static_threat(
+                200 + k,
+                [-60_000.0 - 1000.0 * round as f64, -60_000.0, 0.0],
+                [2000.0, 2000.0, 0.0],
+            ));
+            t += 0.1;
+        }
+        h.wake();
+        assert!(h.wait_processed(PLAN_WAIT), "round {round}: {:?}", h.status);
+    }
+    // One more pass settles the last round's sequences.
+    h.set_time(t);
+    h.send_ownship(on_plan(t));
+    h.wake();
+    assert!(h.wait_processed(PLAN_WAIT));
+    assert_eq!(h.last_status().messages_lost, 0, "at the documented rate");
+    // Ten ownship states before one notification: the buffer keeps the newest four, the
+    // other six are lost, and counted once a later message has been read.
+    for _ in 0..10 {
+        t += 0.1;
+        h.set_time(t);
+        h.send_ownship(on_plan(t));
+    }
+    h.wake();
+    assert!(h.wait_processed(PLAN_WAIT));
+    t += 0.1;
+    h.set_time(t);
+    h.send_ownship(on_plan(t));
+    h.wake();
+    assert!(h.wait_processed(PLAN_WAIT));
+    let s = h.last_status();
+    assert_eq!(s.messages_lost, 6, "{s:?}");
+    assert_eq!(s.messages_rejected, 0);
+    service.stop(|| h.wake()).expect("the service stops");
+}

@@ -81,6 +81,8 @@ pub struct PlannerCounters {
     pub plans_made: u64,
     pub messages_received: u64,
     pub messages_rejected: u64,
+    /// Inputs lost before the planner read them (gaps in the harness's sequence).
+    pub messages_lost: u64,
     pub triggers_coalesced: u64,
     pub triggers_deferred: u64,
     pub popups_clear: u64,
@@ -468,6 +470,7 @@ pub fn build(flight: &Flight) -> Result<Report, ThreatError> {
             plans_made: s.plans_made,
             messages_received: s.messages_received,
             messages_rejected: s.messages_rejected,
+            messages_lost: s.messages_lost,
             triggers_coalesced: s.triggers_coalesced,
             triggers_deferred: s.triggers_deferred,
             popups_clear: s.popups_clear,

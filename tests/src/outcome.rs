@@ -30,7 +30,8 @@ pub fn plans(r: &Value) -> Vec<PlanRow> {
 
 /// The mission's outcome on the flown path: completed, every target within 100 m, the
 /// final point or the lead within 100 m, no safe hold, and (on an avoidable layout, every
-/// scenario without `unavoidable` in its name) never inside a static threat, min F ≥ 1.
+/// scenario without `unavoidable` in its name) never inside a static threat, min F ≥ 1;
+/// and no input lost before the planner read it.
 pub fn assert_mission_succeeded(r: &Value) {
     let name = r["scenario"].as_str().expect("scenario");
     assert_eq!(r["completed"], true, "{name} not completed: {r:#}");
@@ -56,6 +57,10 @@ pub fn assert_mission_succeeded(r: &Value) {
         Some("Initial"),
         "{name}"
     );
+    // The harness publishes at the documented rates: the planner read every input.
+    if let Some(lost) = r["planner"]["messages_lost"].as_u64() {
+        assert_eq!(lost, 0, "{name}: inputs lost before the planner read them");
+    }
 }
 
 /// Every scheduled re-plan time `t_r` is followed: the plan after one that scheduled

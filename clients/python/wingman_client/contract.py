@@ -1,4 +1,4 @@
-"""The wingman planner's message contract (protocol 2), as Python ctypes.
+"""The wingman planner's message contract (protocol 3), as Python ctypes.
 
 Generated from the Rust code (`WINGMAN_BLESS=1 cargo test -p wingman-ipc --test contract`);
 do not edit. Layouts are little-endian and `repr(C)` with no implicit padding;
@@ -7,7 +7,7 @@ docs/INTERFACES.md says what each field means.
 
 import ctypes
 
-PROTOCOL_VERSION = 2
+PROTOCOL_VERSION = 3
 MAX_TARGETS = 8
 MAX_PHASES = 9
 MAX_ROUTE_POINTS = 16
@@ -375,6 +375,7 @@ class PlannerStatus(ctypes.Structure):
         ("current_plan_id", ctypes.c_uint64),
         ("messages_received", ctypes.c_uint64),
         ("messages_rejected", ctypes.c_uint64),
+        ("messages_lost", ctypes.c_uint64),
         ("plans_made", ctypes.c_uint64),
         ("triggers_coalesced", ctypes.c_uint64),
         ("triggers_deferred", ctypes.c_uint64),
@@ -383,7 +384,7 @@ class PlannerStatus(ctypes.Structure):
         ("budget_remaining_ms", ctypes.c_double),
     ]
 
-    SIZE = 112
+    SIZE = 120
     ALIGN = 8
 
     @staticmethod

@@ -75,16 +75,18 @@ pub struct Qos {
 }
 
 /// The quality of service of `service`. Pub-sub services overflow safely (the oldest
-/// buffered sample gives way), so a slow reader never blocks a writer.
+/// buffered sample gives way), so a slow reader never blocks a writer; the planner counts
+/// what it loses anyway (`PlannerStatus::messages_lost`). A client that publishes at most a
+/// buffer's worth on a service between two notifications loses nothing.
 ///
-/// | service | history | buffer | why |
-/// |---|---:|---:|---|
-/// | `tasking` | 1 | 4 | a restarted planner gets the tasking |
-/// | `lead/route` | 1 | 4 | … and the lead's route |
-/// | `lead/state` | 0 | 4 | periodic: the newest is what counts |
-/// | `threats` | 32 | 64 | every known threat (16 static + 8 moving fit); a burst of pop-ups |
-/// | `tracks` | 0 | 32 | fixes of up to 8 moving threats between two wake-ups |
-/// | `ownship` | 0 | 4 | periodic |
+/// | service | history | buffer | what matters | why |
+/// |---|---:|---:|---|---|
+/// | `tasking` | 1 | 4 | every one (commands) | a restarted planner gets the tasking |
+/// | `lead/route` | 1 | 4 | every one | … and the lead's route |
+/// | `lead/state` | 0 | 4 | the newest | periodic |
+/// | `threats` | 32 | 64 | every one | every known threat (16 static + 8 moving fit); a burst of pop-ups |
+/// | `tracks` | 0 | 32 | every one | fixes of up to 8 moving threats between two wake-ups |
+/// | `ownship` | 0 | 4 | the newest | periodic |
 /// | `plan` | 1 | 2 | a restarted tracker gets the current plan (160 KiB each) |
 /// | `status` | 1 | 4 | a late subscriber gets the newest heartbeat |
 pub const fn qos(service: Service) -> Qos {

@@ -181,6 +181,7 @@ pub fn status() -> PlannerStatus {
         current_plan_id: 4,
         messages_received: 1000,
         messages_rejected: 3,
+        messages_lost: 6,
         plans_made: 4,
         triggers_coalesced: 12,
         triggers_deferred: 2,

@@ -6,6 +6,7 @@
 //! message into a slot. [`World::fill_problem`] writes one plan's [`Problem`] into a
 //! problem whose buffers are reused.
 
+use super::sequence_gaps::SequenceGaps;
 use std::time::Duration;
 
 use wingman_interfaces::{
@@ -230,6 +231,8 @@ pub struct World {
     /// Threat reports refused for lack of room (the status then says `Degraded`: the
     /// planner ignores a threat).
     pub threats_dropped: u64,
+    /// Input messages lost before they were read (gaps in the senders' sequences).
+    pub gaps: SequenceGaps,
     last_seen: [Option<Duration>; Input::COUNT],
     last_header: [Option<Header>; Input::COUNT],
 }
@@ -247,6 +250,7 @@ impl Default for World {
             max_sequence: 0,
             epoch: 0,
             threats_dropped: 0,
+            gaps: SequenceGaps::default(),
             last_seen: [None; Input::COUNT],
             last_header: [None; Input::COUNT],
         }

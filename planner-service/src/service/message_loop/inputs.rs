@@ -58,6 +58,7 @@ impl MessageLoop {
         drain!(tracks, Input::Tracks, on_fix);
         drain!(lead_state, Input::LeadState, on_lead_state);
         drain!(ownship, Input::Ownship, on_ownship);
+        self.world.gaps.end_pass();
         self.counters.received - before
     }
 
@@ -70,6 +71,9 @@ impl MessageLoop {
         let checked = msg
             .validate()
             .and_then(|()| self.world.accept_header(input, msg.header(), wall));
+        if msg.header().validate().is_ok() {
+            self.world.gaps.read(msg.header(), checked.is_ok());
+        }
         match checked {
             Ok(()) => true,
             Err(e) => {

@@ -68,6 +68,7 @@ impl MessageLoop {
         };
         s.messages_received = self.counters.received;
         s.messages_rejected = self.counters.rejected;
+        s.messages_lost = self.world.gaps.lost;
         s.plans_made = self.counters.plans;
         s.triggers_coalesced = self.counters.coalesced;
         s.triggers_deferred = self.counters.deferred;
