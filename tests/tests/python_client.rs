@@ -11,13 +11,15 @@ use std::process::Command;
 
 use wingman_testkit::binary;
 use wingman_testkit::process::{TempDir, vehicle};
-use wingman_testkit::python::python_with;
+use wingman_testkit::python::python_with_version;
 
 #[test]
 fn the_python_client_flies_a_short_mission_against_the_planner() {
     let clients = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../clients/python");
-    let python = python_with(
+    // The binding's version must be the Rust crate's (clients/python/requirements.txt).
+    let python = python_with_version(
         "iceoryx2",
+        "0.10.0",
         &clients.join("requirements.txt"),
         "python-client-venv",
     );

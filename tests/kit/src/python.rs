@@ -5,9 +5,10 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn imports(python: &Path, modules: &str) -> bool {
+/// Whether `python` runs `check` (Python code) without an error.
+fn passes(python: &Path, check: &str) -> bool {
     Command::new(python)
-        .args(["-c", &format!("import {modules}")])
+        .args(["-c", check])
         .output()
         .is_ok_and(|o| o.status.success())
 }
@@ -15,13 +16,34 @@ fn imports(python: &Path, modules: &str) -> bool {
 /// `python3` if it imports `modules` (comma-separated), else the virtual environment
 /// `target/<venv>` with `requirements` installed (made on first use).
 pub fn python_with(modules: &str, requirements: &Path, venv: &str) -> PathBuf {
+    python_passing(&format!("import {modules}"), requirements, venv)
+}
+
+/// `python3` if it has version `version` of package `package` (importable as `package`),
+/// else the virtual environment `target/<venv>` with `requirements` installed: for a
+/// package whose version must match exactly (the iceoryx2 binding and the Rust iceoryx2
+/// share memory layouts).
+pub fn python_with_version(
+    package: &str,
+    version: &str,
+    requirements: &Path,
+    venv: &str,
+) -> PathBuf {
+    let check = format!(
+        "import {package}, importlib.metadata as m; \
+         assert m.version('{package}') == '{version}', m.version('{package}')"
+    );
+    python_passing(&check, requirements, venv)
+}
+
+fn python_passing(check: &str, requirements: &Path, venv: &str) -> PathBuf {
     let system = PathBuf::from("python3");
-    if imports(&system, modules) {
+    if passes(&system, check) {
         return system;
     }
     let venv = crate::target_dir().join(venv);
     let python = venv.join("bin/python3");
-    if !imports(&python, modules) {
+    if !passes(&python, check) {
         let ok = Command::new("python3")
             .args(["-m", "venv"])
             .arg(&venv)
