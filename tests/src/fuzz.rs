@@ -15,8 +15,8 @@
 //!
 //! What must hold: a message that passes `validate()` holds no non-finite number; every
 //! message is read, the service rejects (counts in `messages_rejected`) exactly those that
-//! fail `validate()`, it never panics or stops, and every plan and status it publishes
-//! validates. Messages go in rounds of at most four (the smallest subscriber buffer), each
+//! fail `validate()` and counts none as lost (`messages_lost`), it never panics or stops,
+//! and every plan and status it publishes validates. Messages go in rounds of at most four (the smallest subscriber buffer), each
 //! waited for by the service's read count, so none is lost to a full buffer.
 
 use std::time::{Duration, Instant};
@@ -131,19 +131,19 @@ enum Case {
     Ownship(OwnshipState),
 }
 
-/// Random bytes, or `template` with a fresh header and a mutated body.
-fn build<M: Message>(template: &M, header: Header, rng: &mut ChaCha8Rng) -> M {
-    let mut bytes = if rng.random_ratio(1, 3) {
-        let mut b = vec![0u8; size_of::<M>()];
-        rng.fill_bytes(&mut b);
-        b
-    } else {
+/// Random bytes (no header given), or `template` with `header` and a mutated body.
+fn build<M: Message>(template: &M, header: Option<Header>, rng: &mut ChaCha8Rng) -> M {
+    let mut bytes = if let Some(header) = header {
         // Every message starts with its header.
         let mut b = template.as_bytes().to_vec();
         b[..HEADER_BYTES].copy_from_slice(header.as_bytes());
         for _ in 0..rng.random_range(1..=4) {
             mutate(&mut b, rng);
         }
+        b
+    } else {
+        let mut b = vec![0u8; size_of::<M>()];
+        rng.fill_bytes(&mut b);
         b
     };
     bytes.truncate(size_of::<M>());
@@ -184,7 +184,7 @@ fn mutate(b: &mut [u8], rng: &mut ChaCha8Rng) {
 impl Case {
     /// A case of a random type; a tasking or a route template gets the next revision
     /// first, so that a valid one is news to the planner (a new plan).
-    fn draw(t: &mut Templates, header: Header, rng: &mut ChaCha8Rng) -> (usize, Case) {
+    fn draw(t: &mut Templates, header: Option<Header>, rng: &mut ChaCha8Rng) -> (usize, Case) {
         let kind = rng.random_range(0..KINDS.len());
         let case = match kind {
             0 => {
@@ -282,7 +282,8 @@ pub fn run(
         for _ in 0..n {
             // Mission time moves on a millisecond per case: the time triggers run too.
             h.mission_ns += 1_000_000;
-            let header = h.header();
+            // A third are random bytes: they take no sequence of this sender's.
+            let header = (!rng.random_ratio(1, 3)).then(|| h.header());
             let (kind, case) = Case::draw(&mut templates, header, &mut rng);
             let k = summary.cases;
             let valid = case.check().map_err(|what| FuzzFailure {
@@ -306,6 +307,12 @@ pub fn run(
             )));
         }
         let s = h.last_status();
+        if s.messages_lost != 0 {
+            return Err(fail(format!(
+                "after {} cases the service counts {} messages lost (none was)",
+                summary.cases, s.messages_lost
+            )));
+        }
         if s.messages_rejected - rejected_before != summary.invalid {
             return Err(fail(format!(
                 "after {} cases the service rejected {} messages, {} failed validate()",

@@ -12,10 +12,13 @@
 //! still buffered. So at the end of each pass the holes at or below the previous pass's
 //! highest sequence are counted as lost.
 //!
-//! A sender is counted from the end of the first drain that reads it: what it published
-//! before the planner's subscribers were there was never this planner's to read (a
-//! restarted planner reads the history services' old samples and the live ones together,
-//! thousands of sequences apart). The sequences of accepted messages advance a sender; a
+//! A sender is counted from the end of the first drain that reads a live message of it (on
+//! a service without history: ownship, lead state, tracks): what it published before the
+//! planner's subscribers were there was never this planner's to read (a restarted planner
+//! is handed the history services' old samples, thousands of sequences below the live
+//! ones). A message whose header cannot be read (another protocol version) leaves its
+//! hole: its sequence is unknown, and it counts as lost as well as rejected. Sequences
+//! within `2 × WINDOW` of `u64::MAX` are not followed. The sequences of accepted messages advance a sender; a
 //! rejected message whose header is readable fills its hole (it was read, not lost) but
 //! moves nothing, so a garbage sequence cannot open a gap. A jump of more than [`WINDOW`] (a sender that restarted its
 //! counter higher, say) starts the count afresh rather than counting the jump. At most
@@ -30,6 +33,9 @@ pub const WINDOW: u64 = 4096;
 pub const SENDERS: usize = 8;
 
 const WORDS: usize = (WINDOW / 64) as usize;
+/// Messages of one drain kept until their sender is known (the inputs' buffers and
+/// histories hold fewer).
+const EARLY: usize = 256;
 
 /// One sender's record.
 #[derive(Debug, Clone, Copy)]
@@ -80,6 +86,11 @@ impl Sender {
 #[derive(Debug, Clone)]
 pub struct SequenceGaps {
     senders: [Option<Sender>; SENDERS],
+    /// The messages of this drain read before their sender was followed (sender,
+    /// sequence, accepted): applied to a sender that its first live message starts in the
+    /// same drain.
+    early: [(u32, u64, bool); EARLY],
+    early_len: usize,
     /// Messages counted as lost so far.
     pub lost: u64,
 }
@@ -88,16 +99,21 @@ impl Default for SequenceGaps {
     fn default() -> Self {
         SequenceGaps {
             senders: [None; SENDERS],
+            early: [(0, 0, false); EARLY],
+            early_len: 0,
             lost: 0,
         }
     }
 }
 
 impl SequenceGaps {
-    /// A message with this (readable) header was read; `accepted`: it passed the checks.
-    pub fn read(&mut self, header: &Header, accepted: bool) {
+    /// A message with this (readable) header was read; `accepted`: it passed the checks;
+    /// `live`: it came from a service without history (a new subscriber is handed no old
+    /// samples there), so a sender is followed from its first live message on.
+    pub fn read(&mut self, header: &Header, accepted: bool, live: bool) {
         let (id, sequence) = (header.sender_id, header.sequence);
-        if sequence == 0 {
+        // 0 is no sequence; the top of the range is left out, so that no sum here wraps.
+        if sequence == 0 || sequence > u64::MAX - 2 * WINDOW {
             return;
         }
         let slot = self
@@ -105,11 +121,21 @@ impl SequenceGaps {
             .iter()
             .position(|s| s.is_some_and(|s| s.id == id));
         let Some(k) = slot else {
-            if accepted && let Some(free) = self.senders.iter_mut().find(|s| s.is_none()) {
-                *free = Some(Sender::new(id, sequence));
+            if accepted && live {
+                if let Some(free) = self.senders.iter_mut().find(|s| s.is_none()) {
+                    *free = Some(Sender::new(id, sequence));
+                }
+            } else if self.early_len < EARLY {
+                self.early[self.early_len] = (id, sequence, accepted);
+                self.early_len += 1;
             }
             return;
         };
+        self.apply(k, sequence, accepted);
+    }
+
+    /// A message of followed sender `k` was read.
+    fn apply(&mut self, k: usize, sequence: u64, accepted: bool) {
         let Some(s) = &mut self.senders[k] else {
             return;
         };
@@ -118,7 +144,7 @@ impl SequenceGaps {
         }
         if sequence > s.settled + WINDOW {
             if accepted {
-                *s = Sender::new(id, sequence);
+                *s = Sender::new(s.id, sequence);
             }
             return;
         }
@@ -131,13 +157,28 @@ impl SequenceGaps {
     /// The end of a drain pass: the holes at or below the previous pass's highest
     /// sequence are counted as lost.
     pub fn end_pass(&mut self) {
+        // The messages read before their (new) sender was followed, in this drain.
+        for e in 0..self.early_len {
+            let (id, sequence, accepted) = self.early[e];
+            let new = |s: &Option<Sender>| s.is_some_and(|s| s.id == id && s.new);
+            if let Some(k) = self.senders.iter().position(new) {
+                self.apply(k, sequence, accepted);
+            }
+        }
+        self.early_len = 0;
         for s in self.senders.iter_mut().flatten() {
             if s.new {
-                // Counted from here on: everything up to its highest sequence is settled.
+                // Counted from here on: everything up to its highest accepted sequence in
+                // this drain is settled.
                 s.new = false;
+                // The bits of the settled sequences are cleared for reuse; those above
+                // (a rejected message read in this drain) stay.
+                let settle = s.max.min(s.settled + WINDOW);
+                for sequence in s.settled + 1..=settle {
+                    s.take(sequence);
+                }
                 s.settled = s.max;
                 s.max_at_last_pass = s.max;
-                s.read = [0; WORDS];
                 continue;
             }
             for sequence in s.settled + 1..=s.max_at_last_pass {
@@ -162,7 +203,7 @@ mod tests {
     /// Reads `sequences` of sender 2 (accepted) in one pass, then ends it.
     fn pass(g: &mut SequenceGaps, sequences: &[u64]) {
         for &s in sequences {
-            g.read(&h(2, s), true);
+            g.read(&h(2, s), true, true);
         }
         g.end_pass();
     }
@@ -192,8 +233,8 @@ mod tests {
         let mut g = SequenceGaps::default();
         pass(&mut g, &[1]);
         // 2 rejected, read: not lost. A rejected garbage sequence opens no gap.
-        g.read(&h(2, 2), false);
-        g.read(&h(2, 1_000_000_000_000_000), false);
+        g.read(&h(2, 2), false, true);
+        g.read(&h(2, 1_000_000_000_000_000), false, true);
         pass(&mut g, &[3]);
         pass(&mut g, &[4]);
         pass(&mut g, &[]);
@@ -204,13 +245,13 @@ mod tests {
     fn senders_count_apart_and_a_jump_starts_afresh() {
         let mut g = SequenceGaps::default();
         for s in [1, 2] {
-            g.read(&h(2, s), true);
-            g.read(&h(7, s * 2), true);
+            g.read(&h(2, s), true, true);
+            g.read(&h(7, s * 2), true, true);
         }
         g.end_pass();
         // Sender 7 read 2 and 4 in its first drain: 3 is not counted (a restarted
         // planner's first drain mixes old history samples with live ones).
-        g.read(&h(7, 6), true);
+        g.read(&h(7, 6), true, true);
         g.end_pass();
         g.end_pass();
         // 5 is lost.
@@ -219,5 +260,39 @@ mod tests {
         pass(&mut g, &[3 + 2 * WINDOW, 4 + 2 * WINDOW]);
         pass(&mut g, &[]);
         assert_eq!(g.lost, 1);
+    }
+
+    #[test]
+    fn history_samples_start_no_sender_and_the_top_sequences_are_not_followed() {
+        let mut g = SequenceGaps::default();
+        // In its first drain a sender's messages on history services may come before its
+        // first live one, and be newer: they settle it too (3 and 4 are not holes).
+        g.read(&h(3, 3), true, false);
+        g.read(&h(3, 4), true, false);
+        g.read(&h(3, 2), true, true);
+        // A rejected message above the highest accepted one in the first drain is read.
+        g.read(&h(3, 6), false, true);
+        g.end_pass();
+        g.read(&h(3, 5), true, true);
+        g.read(&h(3, 7), true, true);
+        g.end_pass();
+        g.end_pass();
+        assert_eq!(g.lost, 0);
+        // A restarted planner is handed an old tasking (history) before live states.
+        g.read(&h(2, 3), true, false);
+        g.end_pass();
+        pass(&mut g, &[900, 901]);
+        pass(&mut g, &[902]);
+        pass(&mut g, &[]);
+        assert_eq!(g.lost, 0);
+        // A sender whose sequence is at the top of the range is not followed (no sum
+        // wraps, no endless count).
+        let top = u64::MAX;
+        g.read(&h(9, top), true, true);
+        g.end_pass();
+        g.read(&h(9, top), true, true);
+        g.end_pass();
+        g.end_pass();
+        assert_eq!(g.lost, 0);
     }
 }

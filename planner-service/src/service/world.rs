@@ -213,6 +213,10 @@ pub enum BuildError {
     Layout(#[from] ThreatError),
 }
 
+/// Senders whose last header is kept per input (more interleaving on one input is
+/// unusual: two publishers per input service are allowed).
+pub const SENDERS_PER_INPUT: usize = 4;
+
 /// The world model.
 #[derive(Debug, Clone)]
 pub struct World {
@@ -234,7 +238,8 @@ pub struct World {
     /// Input messages lost before they were read (gaps in the senders' sequences).
     pub gaps: SequenceGaps,
     last_seen: [Option<Duration>; Input::COUNT],
-    last_header: [Option<Header>; Input::COUNT],
+    /// Per input, the last accepted header of each of up to [`SENDERS_PER_INPUT`] senders.
+    last_header: [[Option<Header>; SENDERS_PER_INPUT]; Input::COUNT],
 }
 
 impl Default for World {
@@ -252,7 +257,7 @@ impl Default for World {
             threats_dropped: 0,
             gaps: SequenceGaps::default(),
             last_seen: [None; Input::COUNT],
-            last_header: [None; Input::COUNT],
+            last_header: [[None; SENDERS_PER_INPUT]; Input::COUNT],
         }
     }
 }
@@ -278,12 +283,18 @@ impl World {
         wall: Duration,
     ) -> Result<(), ValidationError> {
         let k = input as usize;
-        if let Some(previous) = &self.last_header[k]
-            && previous.sender_id == header.sender_id
-        {
-            header.check_follows(previous)?;
+        let senders = &mut self.last_header[k];
+        let same = senders
+            .iter()
+            .position(|h| h.is_some_and(|h| h.sender_id == header.sender_id));
+        if let Some(previous) = same.and_then(|s| senders[s]) {
+            header.check_follows(&previous)?;
         }
-        self.last_header[k] = Some(*header);
+        // A sender beyond the first few on one input takes the first slot.
+        let slot = same
+            .or_else(|| senders.iter().position(Option::is_none))
+            .unwrap_or(0);
+        senders[slot] = Some(*header);
         self.last_seen[k] = Some(wall);
         self.now_ns = self.now_ns.max(header.mission_time_ns);
         self.max_sequence = self.max_sequence.max(header.sequence);
@@ -593,5 +604,32 @@ pub fn reusable_problem() -> Problem {
             layout: ThreatLayout::new(1.0).expect("positive placeholder stiffness"),
             moving: Vec::with_capacity(MAX_MOVING_THREATS),
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_senders_sequence_must_grow_on_an_input_whoever_else_sends_there() {
+        let mut w = World::default();
+        let wall = Duration::ZERO;
+        let h = |sender: u32, sequence: u64| Header::new(sender, sequence, 1_000);
+        assert!(w.accept_header(Input::Threats, &h(2, 5), wall).is_ok());
+        // Another sender in between: its own counter, accepted.
+        assert!(w.accept_header(Input::Threats, &h(7, 1), wall).is_ok());
+        // The first sender may not step back or repeat, though another sent since.
+        for sequence in [5, 4] {
+            assert!(matches!(
+                w.accept_header(Input::Threats, &h(2, sequence), wall),
+                Err(ValidationError::SequenceNotIncreasing { .. })
+            ));
+        }
+        assert!(w.accept_header(Input::Threats, &h(2, 6), wall).is_ok());
+        // A refused header moved nothing: the highest accepted sequence is 6.
+        assert_eq!(w.max_sequence, 6);
+        // Another input keeps its own record.
+        assert!(w.accept_header(Input::Ownship, &h(2, 3), wall).is_ok());
     }
 }

@@ -13,6 +13,7 @@
 use std::f64::consts::PI;
 
 use crate::collocation::transcription::nearest_turn;
+use crate::estimation::MovingThreat;
 use crate::problem::{Problem, Threats};
 use crate::threat::Superquadric;
 use crate::trajectory::Trajectory;
@@ -56,7 +57,8 @@ pub(super) fn deflected(problem: &Problem, known: &Threats, guess: &Trajectory) 
 }
 
 /// Whether `guess` comes within `F < near` of a threat of `problem` that `known` (the plan
-/// in flight's threats) lacks: the world changed around the plan.
+/// in flight's threats) lacks: the world changed around the plan. A moving threat counts
+/// at each sample's time, and as new whenever its estimate changed.
 pub(super) fn near_new_threat(
     problem: &Problem,
     known: &Threats,
@@ -76,12 +78,39 @@ pub(super) fn near_new_threat(
             })
         })
     }
+    fn any_moving_near<const D: usize>(
+        threats: &[MovingThreat<D>],
+        known: &[MovingThreat<D>],
+        guess: &Trajectory,
+        near: f64,
+    ) -> bool {
+        threats.iter().filter(|t| !known.contains(t)).any(|t| {
+            (0..guess.len()).any(|k| {
+                let p: [f64; D] = std::array::from_fn(|i| guess.states[k][i]);
+                t.f(&p, guess.times[k]) < near
+            })
+        })
+    }
     match (&problem.threats, known) {
-        (Threats::Planar { layout, .. }, Threats::Planar { layout: old, .. }) => {
+        (
+            Threats::Planar { layout, moving },
+            Threats::Planar {
+                layout: old,
+                moving: old_moving,
+            },
+        ) => {
             any_near(layout.threats(), old.threats(), guess, near)
+                || any_moving_near(moving, old_moving, guess, near)
         }
-        (Threats::Spatial { layout, .. }, Threats::Spatial { layout: old, .. }) => {
+        (
+            Threats::Spatial { layout, moving },
+            Threats::Spatial {
+                layout: old,
+                moving: old_moving,
+            },
+        ) => {
             any_near(layout.threats(), old.threats(), guess, near)
+                || any_moving_near(moving, old_moving, guess, near)
         }
         _ => true,
     }

@@ -114,7 +114,7 @@ impl Planner {
             fallback_warm: flying
                 .solution
                 .as_deref()
-                .filter(|_| starts.is_empty() && !near_new),
+                .filter(|_| settings.warm_mesh_changes && starts.is_empty() && !near_new),
             reference: reference_export(settings),
             timing: self.timing[model],
             seen: Seen::default(),

@@ -72,7 +72,8 @@ impl MessageLoop {
             .validate()
             .and_then(|()| self.world.accept_header(input, msg.header(), wall));
         if msg.header().validate().is_ok() {
-            self.world.gaps.read(msg.header(), checked.is_ok());
+            let live = wingman_ipc::qos(M::SERVICE).history_size == 0;
+            self.world.gaps.read(msg.header(), checked.is_ok(), live);
         }
         match checked {
             Ok(()) => true,
