@@ -263,6 +263,18 @@ def main() -> int:
         # 3. Bad inputs.
         bad_inputs(client, plan2, 14.0)
         check(planner.poll() is None, "the planner is alive after every bad input")
+
+        # A second client on the same planner, with the same sender id and a new counter:
+        # it numbers on above the planner's highest accepted sequence and is served.
+        second = Client.connect(a.vehicle)
+        second.wait_for_status()
+        second.publish("Ownship", ownship(plan2, 16.0), 16.0)
+        second.sync(timeout_s=20.0)
+        check(
+            second.status.last_input_sequence == second.sequence
+            and second.status.messages_rejected == client.status.messages_rejected,
+            "a second client numbers on and is accepted",
+        )
     finally:
         code = stop_planner(planner)
     check(code == 0, f"the planner stopped cleanly on SIGTERM (exit {code})")

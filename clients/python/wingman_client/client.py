@@ -130,7 +130,13 @@ class Client:
         # The status first: the planner publishes a plan before the status that follows
         # it, so plans read after a status include every plan that status counts.
         while (sample := self._status.receive()) is not None:
+            first = self.status is None
             self.status = _copy(sample, c.PlannerStatus)
+            if first:
+                # A planner that already served this sender id (an earlier run of this
+                # client) refuses a sequence that does not grow: number on above the
+                # highest it accepted, as a restarted harness does.
+                self.sequence = max(self.sequence, self.status.last_input_sequence)
         new = []
         while (sample := self._plans.receive()) is not None:
             new.append(_copy(sample, c.Plan))
