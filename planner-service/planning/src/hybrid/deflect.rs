@@ -65,55 +65,45 @@ pub(super) fn near_new_threat(
     guess: &Trajectory,
     near: f64,
 ) -> bool {
-    fn any_near<const D: usize>(
-        threats: &[Superquadric<D>],
-        known: &[Superquadric<D>],
-        guess: &Trajectory,
-        near: f64,
-    ) -> bool {
-        threats.iter().filter(|t| !known.contains(t)).any(|t| {
-            guess.states.iter().any(|s| {
-                let p: [f64; D] = std::array::from_fn(|i| s[i]);
-                t.f(&p) < near
-            })
-        })
-    }
-    fn any_moving_near<const D: usize>(
-        threats: &[MovingThreat<D>],
-        known: &[MovingThreat<D>],
-        guess: &Trajectory,
-        near: f64,
-    ) -> bool {
-        threats.iter().filter(|t| !known.contains(t)).any(|t| {
-            (0..guess.len()).any(|k| {
-                let p: [f64; D] = std::array::from_fn(|i| guess.states[k][i]);
-                t.f(&p, guess.times[k]) < near
-            })
-        })
-    }
     match (&problem.threats, known) {
         (
             Threats::Planar { layout, moving },
             Threats::Planar {
-                layout: old,
-                moving: old_moving,
+                layout: l,
+                moving: m,
             },
-        ) => {
-            any_near(layout.threats(), old.threats(), guess, near)
-                || any_moving_near(moving, old_moving, guess, near)
-        }
+        ) => near_in(layout.threats(), moving, l.threats(), m, guess, near),
         (
             Threats::Spatial { layout, moving },
             Threats::Spatial {
-                layout: old,
-                moving: old_moving,
+                layout: l,
+                moving: m,
             },
-        ) => {
-            any_near(layout.threats(), old.threats(), guess, near)
-                || any_moving_near(moving, old_moving, guess, near)
-        }
+        ) => near_in(layout.threats(), moving, l.threats(), m, guess, near),
         _ => true,
     }
+}
+
+/// [`near_new_threat`] in `D` dimensions: static threats not among `known`, moving ones
+/// not among `known_moving`.
+fn near_in<const D: usize>(
+    threats: &[Superquadric<D>],
+    moving: &[MovingThreat<D>],
+    known: &[Superquadric<D>],
+    known_moving: &[MovingThreat<D>],
+    guess: &Trajectory,
+    near: f64,
+) -> bool {
+    let at = |k: usize| -> [f64; D] { std::array::from_fn(|i| guess.states[k][i]) };
+    let samples = 0..guess.len();
+    threats
+        .iter()
+        .filter(|t| !known.contains(t))
+        .any(|t| samples.clone().any(|k| t.f(&at(k)) < near))
+        || moving
+            .iter()
+            .filter(|t| !known_moving.contains(t))
+            .any(|t| samples.clone().any(|k| t.f(&at(k), guess.times[k]) < near))
 }
 
 /// The crossings of `guess` through threats of `threats` not among `known`.
