@@ -91,7 +91,6 @@ impl Planner {
         let started = clock.now();
         let model = usize::from(problem.dim() == 3);
         let bends = deflect::deflected(problem, &flying.threats, &guess);
-        let near_new = deflect::near_new_threat(problem, &flying.threats, &guess, NEAR_NEW_F);
         let starts: Vec<Trajectory> = if bends.is_empty() {
             Vec::new()
         } else {
@@ -111,10 +110,11 @@ impl Planner {
             // threat has come near it (they are the costates of the old world: from them a
             // 3-D solve past a new threat did not converge in 100 ms, from the path alone
             // it did).
-            fallback_warm: flying
-                .solution
-                .as_deref()
-                .filter(|_| settings.warm_mesh_changes && starts.is_empty() && !near_new),
+            fallback_warm: flying.solution.as_deref().filter(|_| {
+                settings.warm_mesh_changes
+                    && starts.is_empty()
+                    && !deflect::near_new_threat(problem, &flying.threats, &guess, NEAR_NEW_F)
+            }),
             reference: reference_export(settings),
             timing: self.timing[model],
             seen: Seen::default(),
