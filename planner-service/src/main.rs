@@ -43,6 +43,14 @@ enum Command {
         /// Output folder (default: runs/<scenario>/plan).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Plan with the yardstick of global optimality (a far wider global search, each
+        /// run from its own seed, 60 s per run unless --deadline-ms says otherwise) instead
+        /// of the deployment settings. Not for flight: it judges the default plan.
+        #[arg(long)]
+        exhaustive: bool,
+        /// Runs of the yardstick (with --exhaustive).
+        #[arg(long, default_value_t = 3, requires = "exhaustive")]
+        runs: usize,
     },
     /// Runs the planner service (iceoryx2 node of one vehicle; stops on SIGTERM/SIGINT).
     ///
@@ -85,6 +93,8 @@ fn main() -> ExitCode {
             seed,
             deadline_ms,
             out,
+            exhaustive,
+            runs,
         } => {
             let sc = match load_by_path_or_name(&scenario) {
                 Ok(sc) => sc,
@@ -99,6 +109,7 @@ fn main() -> ExitCode {
                 seed,
                 deadline: deadline_ms.map(Duration::from_millis),
                 out_dir,
+                exhaustive_runs: exhaustive.then_some(runs),
             };
             let clock: &'static MonotonicClock = Box::leak(Box::new(MonotonicClock::new()));
             match plan_scenario(&request, clock) {

@@ -9,7 +9,9 @@ use wingman_interfaces::{Model, Quality};
 
 use wingman_planning::clock::{Clock, Deadline};
 use wingman_planning::cuts::{Cut, CutLog};
-use wingman_planning::hybrid::{PlanOutcome, Planner, PlannerSettings};
+use wingman_planning::hybrid::{
+    Exhaustive, PlanOutcome, Planner, PlannerSettings, plan_exhaustive,
+};
 use wingman_planning::problem::Problem;
 use wingman_planning::scenario::Scenario;
 
@@ -18,9 +20,12 @@ use wingman_planning::scenario::Scenario;
 pub struct PlanRequest {
     pub scenario: Scenario,
     pub seed: u64,
-    /// Compute budget; `None`: the model's default.
+    /// Compute budget; `None`: the model's default (with `exhaustive`: of each run).
     pub deadline: Option<Duration>,
     pub out_dir: PathBuf,
+    /// Plan with the yardstick of global optimality instead of the deployment settings
+    /// (`hybrid::plan_exhaustive`: this many runs, seeded from `seed` on).
+    pub exhaustive_runs: Option<usize>,
 }
 
 /// Default compute budget of an offline plan.
@@ -37,18 +42,10 @@ pub fn plan_scenario(
     clock: &'static dyn Clock,
 ) -> anyhow::Result<PlanOutcome> {
     let problem = Problem::from_scenario(&request.scenario)?;
-    let mut settings = PlannerSettings::default();
-    settings.swarm = settings.swarm.with_seed(request.seed);
-    let budget = request
-        .deadline
-        .unwrap_or_else(|| default_deadline(problem.model));
-    let mut planner = Planner::new(&settings);
-    // Deadlines need `'static` parts; one small log per offline plan.
-    let log: &'static CutLog = Box::leak(Box::new(CutLog::new()));
-    log.begin(None);
-    let deadline = Deadline::after(clock, budget).with_cuts(log);
-    let outcome = planner.plan(&problem, &settings, deadline)?;
-    let cuts = log.finish();
+    let (outcome, cuts, seeds) = match request.exhaustive_runs {
+        Some(runs) => plan_yardstick(request, &problem, runs, clock)?,
+        None => plan_default(request, &problem, clock)?,
+    };
     std::fs::create_dir_all(&request.out_dir)?;
     write_outputs(
         &request.out_dir,
@@ -61,11 +58,65 @@ pub fn plan_scenario(
         &request.out_dir.join("plan.png"),
         &request.scenario,
         &problem,
-        &planner,
+        seeds,
         &outcome,
     )
     .map_err(|e| anyhow::anyhow!("drawing plan.png: {e}"))?;
     Ok(outcome)
+}
+
+/// The seeds' paths, for the plot.
+type SeedPaths = Vec<Vec<[f64; 2]>>;
+
+/// A plan on the deployment settings: the outcome, its deadline cuts and the seeds.
+fn plan_default(
+    request: &PlanRequest,
+    problem: &Problem,
+    clock: &'static dyn Clock,
+) -> anyhow::Result<(PlanOutcome, Vec<Cut>, SeedPaths)> {
+    let mut settings = PlannerSettings::default();
+    settings.swarm = settings.swarm.with_seed(request.seed);
+    let budget = request
+        .deadline
+        .unwrap_or_else(|| default_deadline(problem.model));
+    let mut planner = Planner::new(&settings);
+    // Deadlines need `'static` parts; one small log per offline plan.
+    let log: &'static CutLog = Box::leak(Box::new(CutLog::new()));
+    log.begin(None);
+    let deadline = Deadline::after(clock, budget).with_cuts(log);
+    let outcome = planner.plan(problem, &settings, deadline)?;
+    let seeds = planner
+        .swarm_workspace()
+        .seed_paths()
+        .map(|(_, points)| points.iter().map(|p| [p[0], p[1]]).collect())
+        .collect();
+    Ok((outcome, log.finish(), seeds))
+}
+
+/// A plan of the yardstick (`runs` runs, each with the request's budget or 60 s); it
+/// draws no seeds (each run has its own), and its cuts are counted, not listed.
+fn plan_yardstick(
+    request: &PlanRequest,
+    problem: &Problem,
+    runs: usize,
+    clock: &'static dyn Clock,
+) -> anyhow::Result<(PlanOutcome, Vec<Cut>, SeedPaths)> {
+    let mut how = Exhaustive {
+        runs,
+        seed: request.seed,
+        ..Exhaustive::default()
+    };
+    if let Some(budget) = request.deadline {
+        how.budget = budget;
+    }
+    let o = plan_exhaustive(problem, &how, clock)?;
+    if o.cuts > 0 {
+        tracing::warn!(
+            cuts = o.cuts,
+            "the yardstick's budget cut its search: a longer --deadline-ms makes it independent of the machine"
+        );
+    }
+    Ok((o.best, Vec::new(), Vec::new()))
 }
 
 /// `plan.png`: the threats, the seeds, the swarm's best and the final plan.
@@ -73,19 +124,19 @@ fn draw_plan(
     path: &Path,
     sc: &Scenario,
     problem: &Problem,
-    planner: &Planner,
+    seeds: SeedPaths,
     o: &PlanOutcome,
 ) -> Result<(), Box<dyn std::error::Error>> {
     use plotters::style::RGBColor;
     use wingman_plot::{MapMarker, MapPath, MapPlot, Stroke, draw_map};
     let xy = |s: &[f64; 7]| [s[0], s[1]];
     let mut paths = Vec::new();
-    for (k, (_, points)) in planner.swarm_workspace().seed_paths().enumerate() {
+    for (k, points) in seeds.into_iter().enumerate() {
         paths.push(MapPath {
             label: (k == 0).then(|| "spline seeds".to_string()),
             color: RGBColor(110, 110, 110),
             stroke: Stroke::Thin,
-            points: points.iter().map(|p| [p[0], p[1]]).collect(),
+            points,
         });
     }
     if let Some(lead) = &problem.lead {

@@ -15,9 +15,11 @@
 //! - [`report`], [`plots`]: `report.json` and the PNG plots;
 //! - [`replay`]: a flown log's planner inputs fed to the planner in-process, every plan
 //!   compared byte for byte;
+//! - [`campaign`]: many random missions flown, judged against the yardstick, reported;
 //! - [`resume`]: `fly --resume`, a new harness taking over the mission a planner flies
 //!   after its harness died.
 
+pub mod campaign;
 pub mod clock;
 pub mod datalink;
 pub mod flight_log;

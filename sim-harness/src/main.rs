@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use wingman_harness::campaign;
 use wingman_harness::clock::ClockMode;
 use wingman_harness::mission::{self, FlyOptions, PlannerMode};
 use wingman_ipc::ServiceConfig;
@@ -61,6 +62,85 @@ enum Command {
     },
     /// Lists the bundled scenarios with their summaries.
     List,
+    /// Flies a campaign of random well-posed missions (or one shard of it), plans each
+    /// take-off again with the yardstick of global optimality, and writes results.json,
+    /// report.md, summary.json and charts into --out. `campaign merge` joins shards.
+    /// Exit 1 if the campaign misses a bar (docs/CAMPAIGN.md); a shard exits 0 once it
+    /// ran (its merge gives the verdict).
+    Campaign(CampaignCmd),
+}
+
+#[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true)]
+struct CampaignCmd {
+    #[command(subcommand)]
+    merge: Option<CampaignSub>,
+    #[command(flatten)]
+    run: CampaignArgs,
+}
+
+#[derive(Subcommand)]
+enum CampaignSub {
+    /// Builds one campaign's results and report from its shards' (results.json files or
+    /// their folders); exit 1 if it misses a bar.
+    Merge {
+        /// The shards' results.
+        #[arg(required = true)]
+        shards: Vec<PathBuf>,
+        /// Folder of the merged results and report.
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+#[derive(clap::Args)]
+struct CampaignArgs {
+    /// Missions in the campaign.
+    #[arg(long, default_value_t = 30)]
+    count: usize,
+    /// Seed of the missions (mission i of seed S is the same in any run or shard).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Flights at a time, each with its own planner process.
+    #[arg(long, default_value_t = 1)]
+    jobs: usize,
+    /// Run only slice i of n (0 <= i < n): the missions whose index is i modulo n.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<String>,
+    /// Only this model (2d, 3d; repeatable).
+    #[arg(long = "model")]
+    models: Vec<String>,
+    /// Only this objective (fixed-time, min-time, min-time-rendezvous; repeatable).
+    #[arg(long = "objective")]
+    objectives: Vec<String>,
+    /// Every mission has this feature (unavoidable, moving, popups, lead-change;
+    /// repeatable).
+    #[arg(long = "with")]
+    with: Vec<String>,
+    /// No mission has this feature (repeatable).
+    #[arg(long = "without")]
+    without: Vec<String>,
+    /// Output folder (default runs/campaign-<seed>, or runs/campaign-<seed>-shard-<i>-of-<n>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Runs of the yardstick per take-off.
+    #[arg(long, default_value_t = 2)]
+    yardstick_runs: usize,
+    /// Budget of each yardstick run, s.
+    #[arg(long, default_value_t = 60.0)]
+    yardstick_budget_s: f64,
+    /// Do not plan the take-offs with the yardstick (no gap is measured).
+    #[arg(long)]
+    no_yardstick: bool,
+    /// Planner configuration of the flights (default: the deployment defaults).
+    #[arg(long, value_name = "FILE")]
+    planner_config: Option<PathBuf>,
+    /// Keep every mission's folder (default: only the failed and outlying ones).
+    #[arg(long)]
+    keep_all: bool,
+    /// No progress line.
+    #[arg(long)]
+    quiet: bool,
 }
 
 #[derive(clap::Args, Clone)]
@@ -105,6 +185,10 @@ fn main() -> ExitCode {
     wingman_ipc::logging::init();
     iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
     match Cli::parse().command {
+        Command::Campaign(c) => match c.merge {
+            Some(CampaignSub::Merge { shards, out }) => campaign_merge(&shards, &out),
+            None => campaign(&c.run),
+        },
         Command::List => match wingman_harness::list_bundled() {
             Ok(rows) => {
                 for (name, summary) in rows {
@@ -260,5 +344,126 @@ fn fly_one(opts: &FlyOptions) -> ExitCode {
             eprintln!("error: {e:#}");
             ExitCode::from(1)
         }
+    }
+}
+
+/// The options of a campaign run from its flags.
+fn campaign_options(a: &CampaignArgs) -> Result<campaign::run::RunOptions, String> {
+    use campaign::kind::{Feature, Filter};
+    use campaign::run::{CampaignSpec, RunOptions, Shard, YardstickSpec};
+    let features = |names: &[String]| -> Result<Vec<Feature>, String> {
+        names.iter().map(|n| Feature::parse(n)).collect()
+    };
+    let filter = Filter {
+        models: a.models.clone(),
+        objectives: a.objectives.clone(),
+        with: features(&a.with)?,
+        without: features(&a.without)?,
+    };
+    filter.validate()?;
+    if a.count == 0 {
+        return Err("--count must be at least 1".into());
+    }
+    if a.jobs == 0 {
+        return Err("--jobs must be at least 1".into());
+    }
+    if !(a.yardstick_budget_s.is_finite() && a.yardstick_budget_s > 0.0) {
+        return Err("--yardstick-budget-s must be a positive number of seconds".into());
+    }
+    if a.yardstick_runs == 0 {
+        return Err("--yardstick-runs must be at least 1 (or --no-yardstick)".into());
+    }
+    let shard = match &a.shard {
+        Some(s) => Shard::parse(s)?,
+        None => Shard::WHOLE,
+    };
+    let out = a.out.clone().unwrap_or_else(|| {
+        let name = if shard == Shard::WHOLE {
+            format!("campaign-{}", a.seed)
+        } else {
+            format!("campaign-{}-shard-{}-of-{}", a.seed, shard.index, shard.of)
+        };
+        PathBuf::from("runs").join(name)
+    });
+    let mut planner_config = match &a.planner_config {
+        Some(path) => ServiceConfig::load(path).map_err(|e| e.to_string())?,
+        None => mission::harness_planner_config("campaign"),
+    };
+    planner_config.status.heartbeat_ms = 200;
+    planner_config.validate().map_err(|e| e.to_string())?;
+    Ok(RunOptions {
+        spec: CampaignSpec {
+            seed: a.seed,
+            count: a.count,
+            filter,
+            yardstick: (!a.no_yardstick).then_some(YardstickSpec {
+                runs: a.yardstick_runs,
+                budget_s: a.yardstick_budget_s,
+                seed: 1,
+            }),
+        },
+        shard,
+        jobs: a.jobs,
+        out_dir: out,
+        planner_config,
+        keep_all: a.keep_all,
+        progress: !a.quiet,
+    })
+}
+
+fn campaign(a: &CampaignArgs) -> ExitCode {
+    let opts = match campaign_options(a) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    match campaign::run::run(&opts) {
+        // A shard's verdict is the merge's to give: a scheduler must not retry a shard
+        // that ran.
+        Ok(results) if opts.shard != campaign::run::Shard::WHOLE => {
+            let _ = report_campaign(&opts.out_dir, &results);
+            ExitCode::SUCCESS
+        }
+        Ok(results) => report_campaign(&opts.out_dir, &results),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+fn campaign_merge(shards: &[PathBuf], out: &std::path::Path) -> ExitCode {
+    match campaign::merge::merge(shards, out) {
+        Ok(results) => report_campaign(out, &results),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Writes the report, prints its verdict; exit 1 if the campaign misses a bar.
+fn report_campaign(out: &std::path::Path, results: &campaign::run::CampaignResults) -> ExitCode {
+    use campaign::summary::{Verdict, write_report};
+    if let Err(e) = write_report(out, results) {
+        eprintln!("error: {e:#}");
+        return ExitCode::from(1);
+    }
+    let v = Verdict::of(results);
+    println!(
+        "{} of {} missions meet the criteria; {} of {} take-off plans within 0.5 % of the yardstick; {} missing. Report: {}/report.md",
+        v.meeting,
+        v.missions,
+        v.within,
+        v.judged,
+        v.missing.len(),
+        out.display()
+    );
+    if v.passes() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(1)
     }
 }

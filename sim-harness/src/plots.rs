@@ -21,14 +21,14 @@ use wingman_plot::{self as plot, MapMarker, MapPath, MapPlot, Stroke};
 use crate::mission::Flight;
 use crate::report::{Report, exposure_series};
 
-type PlotResult<T> = Result<T, Box<dyn Error + Send + Sync>>;
+pub(crate) type PlotResult<T> = Result<T, Box<dyn Error + Send + Sync>>;
 
-fn boxed(e: impl ToString) -> Box<dyn Error + Send + Sync> {
+pub(crate) fn boxed(e: impl ToString) -> Box<dyn Error + Send + Sync> {
     e.to_string().into()
 }
 
 /// Colours of successive plans.
-const PALETTE: [RGBColor; 8] = [
+pub(crate) const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),

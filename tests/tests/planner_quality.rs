@@ -34,6 +34,7 @@ fn every_canonical_plan_meets_the_reference() {
             // no contended CI machine runs out of.
             deadline: Some(std::time::Duration::from_secs(60)),
             out_dir: root.join(name),
+            exhaustive_runs: None,
         };
         let outcome = plan_scenario(&request, clock).unwrap_or_else(|e| panic!("{name}: {e:#}"));
         let csv: PathBuf = request.out_dir.join("plan.csv");

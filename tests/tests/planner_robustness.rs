@@ -29,6 +29,7 @@ fn twenty_random_scenarios_are_planned_feasibly() {
             seed: 1,
             deadline: Some(std::time::Duration::from_secs(60)),
             out_dir: root.join(&name),
+            exhaustive_runs: None,
         };
         let outcome = match plan_scenario(&request, clock) {
             Ok(o) => o,

@@ -10,6 +10,7 @@
 //! within tolerance), `SwarmOnly` (the swarm's lifted path).
 
 mod deflect;
+mod exhaustive;
 mod global;
 mod nlp_stage;
 mod schedule;
@@ -17,6 +18,7 @@ mod settings;
 mod timing;
 mod warm_start;
 
+pub use exhaustive::{Exhaustive, ExhaustiveOutcome, plan_exhaustive};
 use nlp_stage::{Finaled, NlpStage, Ranked, Solved};
 pub use settings::{MeshSettings, PlannerSettings, PlannerSettingsError};
 pub use warm_start::{FlyingPlan, PlanSolution, WarmReport};

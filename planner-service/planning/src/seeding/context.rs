@@ -289,9 +289,25 @@ impl<'a> Context<'a> {
         {
             return direct;
         }
+        let t = self.tan_ramp;
+        if matches!(alt, Altitude::Early | Altitude::Late) {
+            let ramp = (zb - za).abs() / t;
+            if ramp >= len || ramp <= 0.0 {
+                return direct;
+            }
+            let bend = if alt == Altitude::Early {
+                (ramp, zb)
+            } else {
+                (len - ramp, za)
+            };
+            return Profile {
+                s: [0.0, bend.0, len, len],
+                z: [za, bend.1, zb, zb],
+                n: 3,
+            };
+        }
         let top = za.max(zb);
         let mut zp = top + self.high_margin * top.abs();
-        let t = self.tan_ramp;
         if (zp - za) / t + (zp - zb) / t > len {
             zp = 0.5 * (len * t + za + zb);
         }

@@ -23,11 +23,14 @@ pub(super) struct Spec {
 /// in that order.
 pub(super) fn specs(ctx: &Context, settings: &SeedSettings, rng: &mut ChaCha8Rng) -> Vec<Spec> {
     let legs = ctx.legs;
-    let altitudes: &[Altitude] = if ctx.spatial && settings.high_profile {
-        &[Altitude::Direct, Altitude::High]
-    } else {
-        &[Altitude::Direct]
-    };
+    let mut altitudes = vec![Altitude::Direct];
+    if ctx.spatial && settings.high_profile {
+        altitudes.push(Altitude::High);
+    }
+    if ctx.spatial && settings.early_late_profiles {
+        altitudes.extend([Altitude::Early, Altitude::Late]);
+    }
+    let altitudes = altitudes.as_slice();
     let fit = settings.fit_fixed_time && ctx.problem.objective == Objective::FixedTime;
     let n_signs = 3usize.saturating_pow(legs as u32) - 1;
     let fit_budget = if fit {
@@ -182,7 +185,7 @@ fn fit_specs(ctx: &Context, n_signs: usize, altitudes: &[Altitude], specs: &mut 
 }
 
 /// Random curves: a ratio per leg drawn uniformly from `[-random_bulge_max,
-/// random_bulge_max]`, then (with two profiles) a random profile.
+/// random_bulge_max]`, then (with several profiles) a random profile.
 fn random_specs(
     settings: &SeedSettings,
     legs: usize,
@@ -195,10 +198,12 @@ fn random_specs(
         for b in bulges[..legs].iter_mut() {
             *b = settings.random_bulge_max * (2.0 * rng.random::<f64>() - 1.0);
         }
-        let altitude = if altitudes.len() > 1 && rng.random::<f64>() < 0.5 {
-            Altitude::High
-        } else {
-            Altitude::Direct
+        let altitude = match altitudes.len() {
+            1 => Altitude::Direct,
+            // Two profiles: a coin, as it always was (the default's seeds stay the same).
+            2 if rng.random::<f64>() < 0.5 => altitudes[1],
+            2 => altitudes[0],
+            n => altitudes[rng.random_range(0..n)],
         };
         specs.push(Spec {
             bulges,

@@ -12,6 +12,12 @@ pub enum Altitude {
     Direct,
     /// A plateau above both ends of each leg: climb early, descend late.
     High,
+    /// Reach the leg's end altitude first (at the ramp angle), then hold it: descend or
+    /// climb early.
+    Early,
+    /// Hold the leg's start altitude, then reach the end's at the ramp angle: descend or
+    /// climb late.
+    Late,
 }
 
 /// Which family a seed belongs to.
@@ -87,8 +93,13 @@ impl fmt::Display for SeedLabel {
                 }
             }
         }
-        if self.spatial && self.altitude == Altitude::High {
-            write!(f, "/high")?;
+        if self.spatial {
+            match self.altitude {
+                Altitude::Direct => {}
+                Altitude::High => write!(f, "/high")?,
+                Altitude::Early => write!(f, "/early")?,
+                Altitude::Late => write!(f, "/late")?,
+            }
         }
         Ok(())
     }

@@ -25,6 +25,9 @@ pub struct SeedSettings {
     pub fit_fixed_time: bool,
     /// Add the [`Altitude::High`] profile in 3-D. Default true.
     pub high_profile: bool,
+    /// Add the [`Altitude::Early`] and [`Altitude::Late`] profiles in 3-D (descend or
+    /// climb early, or late). Default false.
+    pub early_late_profiles: bool,
     /// Plateau of the high profile above the higher end of a leg, as a fraction of that
     /// end's altitude. Default 0.1 (15 km ends: a 16.5 km plateau, above threats topping
     /// out at 15 km).
@@ -56,6 +59,7 @@ impl Default for SeedSettings {
             random_bulge_max: 0.6,
             fit_fixed_time: true,
             high_profile: true,
+            early_late_profiles: false,
             high_margin: 0.1,
             ramp_gamma_ratio: 0.6,
             max_seeds: 128,
@@ -93,6 +97,11 @@ impl SeedSettings {
     /// Sets [`SeedSettings::high_profile`].
     pub fn with_high_profile(mut self, on: bool) -> Self {
         self.high_profile = on;
+        self
+    }
+    /// Sets [`SeedSettings::early_late_profiles`].
+    pub fn with_early_late_profiles(mut self, on: bool) -> Self {
+        self.early_late_profiles = on;
         self
     }
     /// Sets [`SeedSettings::high_margin`].

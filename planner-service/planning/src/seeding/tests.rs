@@ -36,3 +36,63 @@ fn decode_enumerates_every_combination() {
         }
     }
 }
+
+/// The early and late profiles of the first leg of `3d-fixed-time-avoidable` (15 km down
+/// to a 2 km target): early reaches the target's altitude first at the ramp angle and
+/// holds it, late holds the start's altitude and meets the target's at the ramp angle;
+/// checked on every point of the leg against the ramp computed here.
+#[test]
+fn early_and_late_profiles_descend_first_or_last() {
+    let sc = crate::scenario::bundled("3d-fixed-time-avoidable")
+        .unwrap()
+        .unwrap();
+    let problem = crate::problem::Problem::from_scenario(&sc).unwrap();
+    let settings = SeedSettings::default().with_early_late_profiles(true);
+    let mut out = Vec::new();
+    seeds(&problem, &settings, &mut out).unwrap();
+    let (za, zb) = (sc.start.position_m[2], sc.targets[0][2]);
+    let tan = (settings.ramp_gamma_ratio * sc.vehicle.gamma_max_rad).tan();
+    let ramp = (za - zb).abs() / tan;
+    let mut checked = [0, 0];
+    for seed in &out {
+        let early = match seed.label.altitude {
+            Altitude::Early => true,
+            Altitude::Late => false,
+            _ => continue,
+        };
+        let last = seed.gates[0];
+        let len = seed.arc[last];
+        assert!(ramp < len, "the leg holds the ramp");
+        for k in 0..=last {
+            let (s, z) = (seed.arc[k], seed.points[k][2]);
+            // On the polyline the profile is stretched by at most a few metres in 40 km.
+            let (hold_from, hold_to, held) = if early {
+                (ramp * 1.01, len, zb)
+            } else {
+                (0.0, (len - ramp) * 0.99, za)
+            };
+            if s >= hold_from && s <= hold_to {
+                assert!((z - held).abs() < 1.0, "{}: z {z} at s {s}", seed.label);
+            }
+            let expected_ramp = if early {
+                za - s * tan
+            } else {
+                za - (s - (len - ramp)) * tan
+            };
+            let on_ramp = if early {
+                s < ramp * 0.99
+            } else {
+                s > (len - ramp) * 1.01
+            };
+            if on_ramp {
+                assert!(
+                    (z - expected_ramp).abs() < 0.01 * (za - zb),
+                    "{}: z {z} at s {s}",
+                    seed.label
+                );
+            }
+        }
+        checked[usize::from(early)] += 1;
+    }
+    assert!(checked[0] > 0 && checked[1] > 0, "{checked:?}");
+}
