@@ -327,3 +327,24 @@ fn a_missing_file_is_an_error_not_a_panic() {
     assert_eq!(err.key, "(file)");
     assert!(err.to_string().contains("/nonexistent/x.toml"));
 }
+
+#[test]
+fn more_static_threats_than_the_planner_holds_are_refused() {
+    let base = std::fs::read_to_string(scenarios_dir().join("2d-min-time-avoidable.toml")).unwrap();
+    let with = |n: usize| {
+        let mut text = base.clone();
+        for k in 0..n {
+            text.push_str(&format!(
+                "\n[[threats]]\nname = \"extra-{k}\"\ncenter_m = [{}.0, -90000.0]\naxes_m = [1000.0, 1000.0]\n",
+                10_000 * k
+            ));
+        }
+        Scenario::parse(&text, "many.toml")
+    };
+    let known = with(0).unwrap().threats.len();
+    let room = wingman_planning::threat::MAX_THREATS - known;
+    assert_eq!(with(room).unwrap().threats.len(), 16);
+    let err = with(room + 1).unwrap_err();
+    assert_eq!(err.key, "threats");
+    assert!(err.problem.contains("17 static threats"), "{err}");
+}

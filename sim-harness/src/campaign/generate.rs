@@ -13,6 +13,7 @@
 //! - the static threats and pop-ups keep a gap of 1.5 turn radii between their discs
 //!   (see [`super::layout`]): a path outside every threat exists; in an unavoidable layout
 //!   one target sits inside a defended threat, and only that threat must be crossed;
+//! - at most 16 static threats, pop-ups included (what the planner holds);
 //! - a pop-up appears where the aircraft cannot be yet (farther from the start than it can
 //!   fly by then, with 15 km to spare);
 //! - a moving threat's road keeps clear of the targets and the end;
@@ -25,6 +26,8 @@ use std::fmt::Write;
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+
+use wingman_planning::threat::MAX_THREATS;
 
 use super::kind::{Feature, Filter, MissionKind};
 use super::layout::{Footprint, along, avoiding_length, dist, segment_dist};
@@ -361,7 +364,10 @@ impl Mission {
     /// The static threats known before take-off, near the legs, clear and apart.
     fn draw_threats(&mut self, rng: &mut ChaCha8Rng) {
         let legs = self.legs();
-        let wanted = self.threats.len() + self.n_threats;
+        // The planner holds MAX_THREATS static threats, the defended one and the pop-ups
+        // included.
+        let room = MAX_THREATS.saturating_sub(self.popups.len());
+        let wanted = (self.threats.len() + self.n_threats).min(room);
         for _ in 0..TRIES {
             if self.threats.len() >= wanted {
                 break;
@@ -692,7 +698,12 @@ mod tests {
         }
         assert!((1..=4).all(|n| kinds.iter().any(|k| k.targets == n)));
         assert!(kinds.iter().any(|k| k.threats >= 12));
-        assert!(kinds.iter().all(|k| k.threats >= 3 && k.threats <= 17));
+        // The planner's capacity, pop-ups included.
+        assert!(
+            kinds
+                .iter()
+                .all(|k| k.threats >= 3 && k.threats + k.popups <= MAX_THREATS)
+        );
     }
 
     #[test]

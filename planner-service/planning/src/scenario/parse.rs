@@ -111,7 +111,20 @@ impl Reader<'_> {
         };
 
         let mut threats = Vec::new();
-        for (i, t) in self.tables(root, "threats")?.iter().enumerate() {
+        let tables = self.tables(root, "threats")?;
+        if tables.len() > crate::threat::MAX_THREATS {
+            // A planner holds at most this many static threats (pop-ups included): more
+            // would fail the take-off plan or be dropped in flight.
+            return self.fail(
+                "threats",
+                &format!(
+                    "{} static threats, more than the planner holds ({})",
+                    tables.len(),
+                    crate::threat::MAX_THREATS
+                ),
+            );
+        }
+        for (i, t) in tables.iter().enumerate() {
             threats.push(self.static_threat(t, &format!("threats[{i}]"), dim)?);
         }
         let mut moving_threats = Vec::new();
