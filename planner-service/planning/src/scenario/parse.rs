@@ -117,7 +117,7 @@ impl Reader<'_> {
             // would fail the take-off plan or be dropped in flight.
             return self.fail(
                 "threats",
-                &format!(
+                format!(
                     "{} static threats, more than the planner holds ({})",
                     tables.len(),
                     crate::threat::MAX_THREATS
