@@ -19,6 +19,8 @@ use super::run::CampaignResults;
 pub const CRITERIA_BAR: f64 = 0.99;
 /// Share of missions whose take-off plan must be within [`GAP_TOL`] of the yardstick.
 pub const GAP_BAR: f64 = 0.98;
+/// Where the gap chart's axis ends, %.
+const GAP_AXIS: f64 = 10.0;
 
 /// The headline numbers.
 #[derive(Debug, Clone, PartialEq)]
@@ -497,19 +499,21 @@ fn draw_charts(
     dir: &Path,
     r: &CampaignResults,
 ) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
+    // A few gaps of thousands of percent would squeeze the rest into one pixel: the axis
+    // stops at GAP_AXIS, larger gaps are drawn at its end.
     let per_model = |model: &str| Series {
         label: model.to_string(),
         values: r
             .outcomes
             .iter()
             .filter(|o| o.kind.model == model)
-            .filter_map(|o| o.gap().map(|g| 100.0 * g))
+            .filter_map(|o| o.gap().map(|g| (100.0 * g).clamp(-GAP_AXIS, GAP_AXIS)))
             .collect(),
     };
     draw_cdf(
         &dir.join("gap_cdf.png"),
         &Cdf {
-            title: "default take-off plan's cost over the yardstick's",
+            title: "default take-off plan's cost over the yardstick's (gaps beyond ±10 % at the ends)",
             x_label: "gap [%]",
             series: vec![per_model("2d"), per_model("3d")],
             marks: vec![(format!("{:.1} %", 100.0 * GAP_TOL), 100.0 * GAP_TOL)],
