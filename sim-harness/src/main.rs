@@ -114,7 +114,7 @@ struct CampaignArgs {
     #[arg(long = "objective")]
     objectives: Vec<String>,
     /// Every mission has this feature (unavoidable, moving, popups, lead-change;
-    /// repeatable).
+    /// repeatable; a mission whose layout had no room for it is drawn again).
     #[arg(long = "with")]
     with: Vec<String>,
     /// No mission has this feature (repeatable).
@@ -367,7 +367,9 @@ fn campaign_options(a: &CampaignArgs) -> Result<campaign::run::RunOptions, Strin
     if a.jobs == 0 {
         return Err("--jobs must be at least 1".into());
     }
-    if !(a.yardstick_budget_s.is_finite() && a.yardstick_budget_s > 0.0) {
+    if !(a.yardstick_budget_s > 0.0
+        && std::time::Duration::try_from_secs_f64(a.yardstick_budget_s).is_ok())
+    {
         return Err("--yardstick-budget-s must be a positive number of seconds".into());
     }
     if a.yardstick_runs == 0 {
@@ -401,6 +403,7 @@ fn campaign_options(a: &CampaignArgs) -> Result<campaign::run::RunOptions, Strin
                 budget_s: a.yardstick_budget_s,
                 seed: 1,
             }),
+            planner_config: a.planner_config.as_ref().map(|p| p.display().to_string()),
         },
         shard,
         jobs: a.jobs,

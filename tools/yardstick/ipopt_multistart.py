@@ -129,7 +129,7 @@ def straight_guess(sc, bulge):
     P = np.array(xs)
     dP = np.gradient(P, ts, axis=0)
     head = np.unwrap(np.arctan2(dP[:, 1], dP[:, 0]))
-    head += sc.x0[sc.heading_index] - head[0] if abs(head[0] - sc.x0[sc.heading_index]) > math.pi else 0.0
+    head += 2 * math.pi * round((sc.x0[sc.heading_index] - head[0]) / (2 * math.pi))
     if sc.model == "2d":
         X = np.column_stack([P, head])
         U = np.gradient(head, ts)[:, None]

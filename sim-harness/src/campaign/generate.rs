@@ -46,12 +46,34 @@ pub struct Drawn {
 /// Longest the placement of one kind of threat tries before it gives up on the rest.
 const TRIES: usize = 2000;
 
-/// Mission `index` of the campaign drawn from `seed` under `filter`.
+/// Draws of one mission before it gives up on a feature the filter requires.
+const ATTEMPTS: u64 = 64;
+
+/// Mission `index` of the campaign drawn from `seed` under `filter`. A feature the filter
+/// requires that the layout had no room for (a pop-up, a moving threat, a defended
+/// threat) is drawn again from a stream derived from the first, up to [`ATTEMPTS`] times.
 pub fn draw(seed: u64, index: usize, filter: &Filter) -> Drawn {
-    let mut rng = ChaCha8Rng::seed_from_u64(
-        seed.wrapping_mul(0x9e37_79b9_7f4a_7c15)
-            .wrapping_add(index as u64),
-    );
+    let mut drawn = draw_once(seed, index, 0, filter);
+    for attempt in 1..ATTEMPTS {
+        if filter.with.iter().all(|f| drawn.kind.has(*f)) {
+            break;
+        }
+        drawn = draw_once(seed, index, attempt, filter);
+    }
+    drawn
+}
+
+/// One draw of mission `index`: attempt 0 from the mission's own stream, later attempts
+/// from streams derived from it.
+fn draw_once(seed: u64, index: usize, attempt: u64, filter: &Filter) -> Drawn {
+    let stream = seed
+        .wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        .wrapping_add(index as u64);
+    let mut rng = ChaCha8Rng::seed_from_u64(if attempt == 0 {
+        stream
+    } else {
+        stream ^ attempt.wrapping_mul(0xd6e8_feb8_6659_fd93)
+    });
     let mut m = Mission::draw_kind(&mut rng, filter);
     m.draw_route(&mut rng);
     if m.unavoidable {
@@ -485,6 +507,8 @@ impl Mission {
             moving: self.moving.len(),
             unavoidable: self.unavoidable,
             lead_change: self.lead_turn.is_some(),
+            // Placed first, it is `t0` (see `draw_defended`).
+            defended: self.unavoidable.then(|| "t0".to_string()),
         }
     }
 
@@ -721,6 +745,18 @@ mod tests {
                 ("3d", "min-time-rendezvous")
             );
             assert!(k.lead_change && k.moving == 0);
+        }
+        // Required features the layout could not place are drawn again.
+        let crowded = Filter {
+            with: vec![Feature::Popups, Feature::Moving, Feature::Unavoidable],
+            ..Filter::default()
+        };
+        for index in 0..40 {
+            let k = draw(2, index, &crowded).kind;
+            assert!(
+                k.popups > 0 && k.moving > 0 && k.unavoidable,
+                "{index}: {k:?}"
+            );
         }
     }
 

@@ -65,6 +65,10 @@ pub struct MissionKind {
     pub moving: usize,
     pub unavoidable: bool,
     pub lead_change: bool,
+    /// The defended threat an unavoidable layout's target sits in (the one threat its
+    /// flight may enter).
+    #[serde(default)]
+    pub defended: Option<String>,
 }
 
 impl MissionKind {

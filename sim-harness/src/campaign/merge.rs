@@ -9,8 +9,9 @@ use super::run::{CampaignResults, RESULTS_FORMAT, read_results, write_results};
 /// Merges the results at `inputs` into `out` (its `results.json` and `missions/`).
 pub fn merge(inputs: &[PathBuf], out: &Path) -> anyhow::Result<CampaignResults> {
     anyhow::ensure!(!inputs.is_empty(), "nothing to merge");
-    std::fs::create_dir_all(out.join("missions"))?;
+    // Every input read and joined first: a refused merge copies nothing.
     let mut merged: Option<CampaignResults> = None;
+    let mut folders = Vec::new();
     for input in inputs {
         let r = read_results(input)?;
         let from = if input.is_dir() {
@@ -18,13 +19,17 @@ pub fn merge(inputs: &[PathBuf], out: &Path) -> anyhow::Result<CampaignResults> 
         } else {
             input.parent().map_or_else(PathBuf::new, Path::to_path_buf)
         };
-        copy_kept(&r, &from, out)?;
+        folders.push((from, r.clone()));
         merged = Some(match merged {
             None => r,
             Some(m) => join(m, r, input)?,
         });
     }
     let mut merged = merged.ok_or_else(|| anyhow::anyhow!("nothing to merge"))?;
+    std::fs::create_dir_all(out.join("missions"))?;
+    for (from, r) in &folders {
+        copy_kept(r, from, out)?;
+    }
     merged.format = RESULTS_FORMAT;
     merged.shards.sort_by_key(|s| (s.of, s.index));
     merged.runs.sort_by_key(|r| (r.shard.of, r.shard.index));

@@ -46,6 +46,9 @@ pub struct FlightNumbers {
     pub plans: Vec<PlanNumbers>,
     pub holds: usize,
     pub messages_lost: u64,
+    /// Smallest F of each static threat (pop-ups included) along the flown path.
+    #[serde(default)]
+    pub min_f_by_threat: Vec<(String, f64)>,
 }
 
 /// The yardstick's take-off plan.
@@ -70,6 +73,9 @@ pub struct MissionOutcome {
     pub error: Option<String>,
     pub flight: Option<FlightNumbers>,
     pub yardstick: Option<YardstickNumbers>,
+    /// Why the yardstick could not plan the take-off (the flight's numbers stand).
+    #[serde(default)]
+    pub yardstick_error: Option<String>,
     /// The criteria it missed, in words (empty: it meets them all).
     pub misses: Vec<String>,
     /// Its folder under the campaign's, kept when it failed or its take-off plan is
@@ -85,12 +91,18 @@ impl FlightNumbers {
             completed: r.completed,
             end: r.end.to_string(),
             end_s: r.end_s,
-            target_miss_m: r.targets.iter().map(|t| t.miss_m).collect(),
-            final_error_m: r.final_error_m,
-            final_time_error_s: r.final_time_error_s,
-            min_f_static: r.min_f_static,
-            min_f_moving: r.min_f_moving,
-            exposure_s: r.exposure_integral,
+            target_miss_m: r.targets.iter().map(|t| finite(t.miss_m)).collect(),
+            final_error_m: finite(r.final_error_m),
+            final_time_error_s: r.final_time_error_s.map(finite),
+            min_f_static: r.min_f_static.map(finite),
+            min_f_moving: r.min_f_moving.map(finite),
+            exposure_s: finite(r.exposure_integral),
+            min_f_by_threat: r
+                .threats
+                .iter()
+                .filter(|t| t.kind == "static")
+                .map(|t| (t.name.clone(), finite(t.min_f)))
+                .collect(),
             plans: r
                 .plans
                 .iter()
@@ -99,8 +111,8 @@ impl FlightNumbers {
                     at_s: p.at_s,
                     quality: p.quality.clone(),
                     path: p.path.clone(),
-                    compute_ms: p.compute_ms,
-                    cost: p.cost,
+                    compute_ms: finite(p.compute_ms),
+                    cost: finite(p.cost),
                     cuts: p.cuts,
                 })
                 .collect(),
@@ -136,6 +148,17 @@ impl FlightNumbers {
         {
             misses.push(format!("entered a static threat (min F {f:.3})"));
         }
+        // Where a target sits in a defended threat, only that threat may be entered.
+        if kind.unavoidable
+            && let Some((name, f)) = self
+                .min_f_by_threat
+                .iter()
+                .filter(|(name, _)| Some(name) != kind.defended.as_ref())
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+            && *f < 1.0
+        {
+            misses.push(format!("entered static threat {name} (min F {f:.3})"));
+        }
         misses
     }
 
@@ -145,7 +168,40 @@ impl FlightNumbers {
     }
 }
 
+/// `x`, or `f64::MAX` with its sign when it is not finite (JSON has no infinity, and a
+/// `null` would not read back): "never reached" reads as 1.8e308 m.
+pub fn finite(x: f64) -> f64 {
+    if x.is_finite() {
+        x
+    } else if x < 0.0 {
+        -f64::MAX
+    } else {
+        f64::MAX
+    }
+}
+
 impl MissionOutcome {
+    /// A mission that could not be flown: `error` says why.
+    pub fn not_flown(
+        index: usize,
+        name: &str,
+        kind: &MissionKind,
+        error: String,
+    ) -> MissionOutcome {
+        MissionOutcome {
+            index,
+            name: name.to_string(),
+            kind: kind.clone(),
+            error: Some(error),
+            flight: None,
+            yardstick: None,
+            yardstick_error: None,
+            misses: vec!["not flown".into()],
+            kept: None,
+            wall_s: 0.0,
+        }
+    }
+
     /// Whether the mission was flown and meets every criterion.
     pub fn meets_criteria(&self) -> bool {
         self.error.is_none() && self.misses.is_empty()
@@ -181,6 +237,7 @@ mod tests {
             moving: 0,
             unavoidable,
             lead_change: false,
+            defended: unavoidable.then(|| "t0".to_string()),
         }
     }
 
@@ -206,6 +263,7 @@ mod tests {
             }],
             holds: 0,
             messages_lost: 0,
+            min_f_by_threat: vec![("t0".into(), 0.2), ("t1".into(), 1.2)],
         }
     }
 
@@ -220,8 +278,14 @@ mod tests {
         let m = f.misses(&kind(false));
         assert_eq!(m.len(), 4, "{m:?}");
         assert!(m[0].contains("target 2") && m[3].contains("0.900"));
-        // Entering a threat is allowed where a target sits inside one.
+        // Entering the defended threat is allowed where a target sits inside it; another
+        // one is not.
         assert_eq!(f.misses(&kind(true)).len(), 3);
+        f.min_f_by_threat[1].1 = 0.9;
+        let m = f.misses(&kind(true));
+        assert!(m.last().unwrap().contains("threat t1"), "{m:?}");
+        assert_eq!(finite(f64::INFINITY), f64::MAX);
+        assert_eq!(finite(f64::NEG_INFINITY), -f64::MAX);
     }
 
     #[test]
@@ -239,6 +303,7 @@ mod tests {
                 cuts: 0,
                 compute_s: 1.0,
             }),
+            yardstick_error: None,
             misses: Vec::new(),
             kept: None,
             wall_s: 1.0,

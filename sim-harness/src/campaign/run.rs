@@ -19,7 +19,7 @@ use wingman_planning::scenario::Scenario;
 
 use super::generate::{Drawn, draw};
 use super::kind::Filter;
-use super::outcome::{FlightNumbers, MissionOutcome, YardstickNumbers};
+use super::outcome::{FlightNumbers, MissionOutcome, YardstickNumbers, finite};
 use super::progress::Progress;
 use crate::mission::{self, FlyOptions};
 
@@ -83,6 +83,9 @@ pub struct CampaignSpec {
     pub filter: Filter,
     /// `None`: no yardstick (the gap is not measured).
     pub yardstick: Option<YardstickSpec>,
+    /// The planner configuration file the flights used (`None`: the deployment defaults).
+    #[serde(default)]
+    pub planner_config: Option<String>,
 }
 
 /// The results file of a campaign or of some of its shards.
@@ -159,7 +162,25 @@ pub fn run(opts: &RunOptions) -> anyhow::Result<CampaignResults> {
                         break;
                     };
                     let drawn = draw(opts.spec.seed, index, &opts.spec.filter);
-                    let outcome = fly_mission(opts, &drawn, &missions_dir, clock);
+                    // A panic in one mission is that mission's error, not the campaign's end.
+                    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                        fly_mission(opts, &drawn, &missions_dir, clock)
+                    }))
+                    .unwrap_or_else(|panic| {
+                        let what = panic
+                            .downcast_ref::<String>()
+                            .cloned()
+                            .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                            .unwrap_or_default();
+                        let mut o = MissionOutcome::not_flown(
+                            drawn.index,
+                            &drawn.name,
+                            &drawn.kind,
+                            format!("panicked: {what}"),
+                        );
+                        o.kept = Some(format!("missions/{}", drawn.name));
+                        o
+                    });
                     let mut guard = shared.lock().unwrap_or_else(|p| p.into_inner());
                     let (res, progress) = &mut *guard;
                     progress.done(&outcome);
@@ -191,27 +212,20 @@ fn fly_mission(
 ) -> MissionOutcome {
     let started = Instant::now();
     let dir = missions_dir.join(&drawn.name);
-    let mut outcome = MissionOutcome {
-        index: drawn.index,
-        name: drawn.name.clone(),
-        kind: drawn.kind.clone(),
-        error: None,
-        flight: None,
-        yardstick: None,
-        misses: Vec::new(),
-        kept: None,
-        wall_s: 0.0,
-    };
+    let mut outcome =
+        MissionOutcome::not_flown(drawn.index, &drawn.name, &drawn.kind, String::new());
     match fly_and_judge(opts, drawn, &dir, clock) {
         Ok((flight, yardstick)) => {
+            outcome.error = None;
             outcome.misses = flight.misses(&drawn.kind);
             outcome.flight = Some(flight);
-            outcome.yardstick = yardstick;
+            match yardstick {
+                Some(Ok(y)) => outcome.yardstick = Some(y),
+                Some(Err(e)) => outcome.yardstick_error = Some(e),
+                None => {}
+            }
         }
-        Err(e) => {
-            outcome.error = Some(format!("{e:#}"));
-            outcome.misses = vec!["not flown".into()];
-        }
+        Err(e) => outcome.error = Some(format!("{e:#}")),
     }
     if opts.keep_all || outcome.outlying() {
         outcome.kept = Some(format!("missions/{}", drawn.name));
@@ -222,13 +236,14 @@ fn fly_mission(
     outcome
 }
 
-/// The flight's numbers and the yardstick's take-off plan of one mission.
+/// The flight's numbers and the yardstick's take-off plan of one mission (or why the
+/// yardstick could not plan it: the flight stands either way).
 fn fly_and_judge(
     opts: &RunOptions,
     drawn: &Drawn,
     dir: &Path,
     clock: &'static MonotonicClock,
-) -> anyhow::Result<(FlightNumbers, Option<YardstickNumbers>)> {
+) -> anyhow::Result<(FlightNumbers, Option<Result<YardstickNumbers, String>>)> {
     use anyhow::Context;
     std::fs::create_dir_all(dir).with_context(|| format!("create {}", dir.display()))?;
     let file = dir.join(format!("{}.toml", drawn.name));
@@ -244,10 +259,11 @@ fn fly_and_judge(
     let json = serde_json::to_string_pretty(&report).context("report as JSON")?;
     std::fs::write(dir.join("report.json"), json + "\n").context("write report.json")?;
     let numbers = FlightNumbers::of(&report);
-    let yardstick = match &opts.spec.yardstick {
-        Some(spec) => Some(yardstick(&scenario, spec, clock)?),
-        None => None,
-    };
+    let yardstick = opts
+        .spec
+        .yardstick
+        .as_ref()
+        .map(|spec| yardstick(&scenario, spec, clock).map_err(|e| format!("{e:#}")));
     Ok((numbers, yardstick))
 }
 
@@ -260,9 +276,9 @@ fn yardstick(
     let problem = Problem::from_scenario(scenario)?;
     let o = plan_exhaustive(&problem, &spec.exhaustive(), clock)?;
     Ok(YardstickNumbers {
-        cost: o.best.cost,
+        cost: finite(o.best.cost),
         quality: o.best.quality.name().to_string(),
-        run_costs: o.runs.iter().map(|(_, c)| *c).collect(),
+        run_costs: o.runs.iter().map(|(_, c)| finite(*c)).collect(),
         cuts: o.cuts,
         compute_s: o.elapsed.as_secs_f64(),
     })

@@ -37,11 +37,12 @@ pub struct Verdict {
 impl Verdict {
     pub fn of(r: &CampaignResults) -> Verdict {
         let have: std::collections::BTreeSet<usize> = r.outcomes.iter().map(|o| o.index).collect();
-        let expected: Vec<usize> = r
-            .shards
-            .iter()
-            .flat_map(|s| s.indices(r.spec.count))
-            .collect();
+        // One shard's own results expect its slice; a whole run or a merge, every mission
+        // (a shard left out of a merge shows as missing missions).
+        let expected: Vec<usize> = match r.shards.as_slice() {
+            [one] => one.indices(r.spec.count),
+            _ => (0..r.spec.count).collect(),
+        };
         let mut missing: Vec<usize> = expected.into_iter().filter(|i| !have.contains(i)).collect();
         missing.sort_unstable();
         let gaps: Vec<f64> = r.outcomes.iter().filter_map(MissionOutcome::gap).collect();
@@ -49,7 +50,13 @@ impl Verdict {
             missions: r.outcomes.len(),
             missing,
             meeting: r.outcomes.iter().filter(|o| o.meets_criteria()).count(),
-            judged: gaps.len(),
+            // With a yardstick every mission is judged: one without a gap (not flown, no
+            // take-off plan, the yardstick failed) counts as outside.
+            judged: if r.spec.yardstick.is_some() {
+                r.outcomes.len()
+            } else {
+                0
+            },
             within: gaps.iter().filter(|g| **g <= GAP_TOL).count(),
         }
     }
@@ -86,6 +93,9 @@ pub fn command(r: &CampaignResults) -> String {
     if !flags.is_empty() {
         c.push(' ');
         c.push_str(&flags);
+    }
+    if let Some(config) = &s.planner_config {
+        let _ = write!(c, " --planner-config {config}");
     }
     match &s.yardstick {
         None => c.push_str(" --no-yardstick"),
@@ -190,8 +200,8 @@ fn write_header(s: &mut String, r: &CampaignResults, v: &Verdict) {
     let _ = writeln!(
         s,
         "Criteria: every target and the end (the final point, or the lead at the rendezvous) \
-         within 100 m; a fixed final time within 2 s; on an avoidable layout the flown path \
-         never inside a static threat (pop-ups included), min F ≥ 1. The gap is the default \
+         within 100 m; a fixed final time within 2 s; the flown path never inside a static \
+         threat (pop-ups included; min F ≥ 1) but, on an unavoidable layout, the defended one. The gap is the default \
          take-off plan's cost `c` over the yardstick's `y`, `(c − y) / max(|y|, 0.02)` \
          (negative: the default did better; below 0.02 costs compare in absolute terms, \
          within 1e-4). Verdict: **{}**.\n",
@@ -251,7 +261,7 @@ fn write_kinds(s: &mut String, r: &CampaignResults) {
     for (label, lo, hi) in [
         ("3–7 threats", 3, 7),
         ("8–11 threats", 8, 11),
-        ("12–17 threats", 12, 17),
+        ("12–16 threats", 12, 16),
     ] {
         let g: Vec<&MissionOutcome> = r
             .outcomes
