@@ -8,6 +8,7 @@ use wingman_interfaces::{Model, Objective, PlanPath, Quality, Trigger};
 use wingman_planning::metrics::{TargetMiss, simpson, target_misses};
 use wingman_planning::threat::{ExposureAcc, Superquadric, ThreatError, ThreatLayout};
 
+use crate::campaign::layout::{segment_dist, xy};
 use crate::mission::{EndReason, Flight, position};
 
 /// A target's outcome.
@@ -172,7 +173,8 @@ fn moving_region<const D: usize>(flight: &Flight, i: usize, k: usize) -> Option<
     let road = &m.road_m;
     let seg = (0..road.len().saturating_sub(1))
         .min_by(|&a, &b| {
-            seg_dist(&road[a], &road[a + 1], &p).total_cmp(&seg_dist(&road[b], &road[b + 1], &p))
+            let to = |k: usize| segment_dist(xy(&road[k]), xy(&road[k + 1]), xy(&p));
+            to(a).total_cmp(&to(b))
         })
         .unwrap_or(0);
     let (a, b) = (road.get(seg)?, road.get(seg + 1)?);
@@ -184,18 +186,6 @@ fn moving_region<const D: usize>(flight: &Flight, i: usize, k: usize) -> Option<
         yaw,
     )
     .ok()
-}
-
-fn seg_dist(a: &[f64; 3], b: &[f64; 3], p: &[f64; 3]) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let r = [p[0] - a[0], p[1] - a[1]];
-    let l2 = d[0] * d[0] + d[1] * d[1];
-    let s = if l2 > 0.0 {
-        ((r[0] * d[0] + r[1] * d[1]) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (r[0] - s * d[0]).hypot(r[1] - s * d[1])
 }
 
 fn flown_positions<const D: usize>(flight: &Flight) -> Vec<[f64; D]> {

@@ -30,7 +30,7 @@ use rand_chacha::ChaCha8Rng;
 use wingman_planning::threat::MAX_THREATS;
 
 use super::kind::{Feature, Filter, MissionKind};
-use super::layout::{Footprint, along, avoiding_length, dist, segment_dist};
+use super::layout::{Footprint, along, avoiding_length, dist, segment_dist, xy};
 
 /// One drawn mission.
 #[derive(Debug, Clone)]
@@ -671,10 +671,6 @@ impl Mission {
             format!("[{:.1}, {:.1}]", p[0], p[1])
         }
     }
-}
-
-fn xy(p: &[f64; 3]) -> [f64; 2] {
-    [p[0], p[1]]
 }
 
 #[cfg(test)]

@@ -42,21 +42,27 @@ impl Footprint {
     }
 }
 
+/// The horizontal part of a point.
+pub fn xy(p: &[f64; 3]) -> [f64; 2] {
+    [p[0], p[1]]
+}
+
 /// Distance of two points, m.
 pub fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).hypot(a[1] - b[1])
 }
 
-/// Distance of `p` from the segment `a`–`b`, m.
+/// Horizontal distance of `p` from the segment `a`–`b`, m (the flight report's too).
 pub fn segment_dist(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
     let d = [b[0] - a[0], b[1] - a[1]];
+    let r = [p[0] - a[0], p[1] - a[1]];
     let l2 = d[0] * d[0] + d[1] * d[1];
     let s = if l2 > 0.0 {
-        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
+        ((r[0] * d[0] + r[1] * d[1]) / l2).clamp(0.0, 1.0)
     } else {
         0.0
     };
-    dist([a[0] + s * d[0], a[1] + s * d[1]], p)
+    (r[0] - s * d[0]).hypot(r[1] - s * d[1])
 }
 
 /// The point a fraction `f` along `a`–`b`, moved `side` metres to its left.
