@@ -1,4 +1,4 @@
-/* wingman.h: the wingman planner's message contract for C and C++ (protocol 3).
+/* wingman.h: the wingman planner's message contract for C and C++ (protocol 4).
  * Generated from the Rust code (`WINGMAN_BLESS=1 cargo test -p wingman-ipc --test
  * contract`); do not edit. Layouts are little-endian, `#[repr(C)]`, with no implicit
  * padding; docs/INTERFACES.md says what each field means. */
@@ -17,7 +17,7 @@
 #endif
 
 /* Constants */
-#define WINGMAN_PROTOCOL_VERSION 3
+#define WINGMAN_PROTOCOL_VERSION 4
 #define WINGMAN_MAX_TARGETS 8
 #define WINGMAN_MAX_PHASES 9
 #define WINGMAN_MAX_ROUTE_POINTS 16
@@ -68,6 +68,7 @@
 #define WINGMAN_TRIGGER_DEVIATION 5
 #define WINGMAN_TRIGGER_EXPIRY 6
 #define WINGMAN_TRIGGER_RESTART 7
+#define WINGMAN_TRIGGER_REFINE 8
 #define WINGMAN_QUALITY_OPTIMAL 0
 #define WINGMAN_QUALITY_FEASIBLE 1
 #define WINGMAN_QUALITY_SWARM_ONLY 2

@@ -279,6 +279,34 @@ fn pending_triggers_name_the_plan_by_priority() {
     assert!(s.contains(Trigger::ScheduledReplan) && !s.contains(Trigger::Expiry));
 }
 
+#[test]
+fn a_plan_short_of_optimal_is_refined_once_with_the_plan_budget() {
+    // Fires: every quality short of `Optimal`, whatever re-plan made it.
+    for q in [Quality::Feasible, Quality::SwarmOnly, Quality::Degraded] {
+        for t in [
+            Trigger::Initial,
+            Trigger::PopUp,
+            Trigger::LeadRoute,
+            Trigger::Expiry,
+        ] {
+            assert!(refine_due(true, q, t), "{q:?} after {t:?}");
+        }
+    }
+    // Near misses: an optimal plan, a refinement's own plan, the setting off.
+    assert!(!refine_due(true, Quality::Optimal, Trigger::PopUp));
+    assert!(!refine_due(true, Quality::SwarmOnly, Trigger::Refine));
+    assert!(!refine_due(false, Quality::SwarmOnly, Trigger::PopUp));
+    // Its budget is the plan budget only while nothing else is pending.
+    let mut s = TriggerSet::default();
+    assert!(!refine_only(s));
+    s.insert(Trigger::Refine);
+    assert!(refine_only(s) && !from_scratch(s));
+    assert_eq!(s.primary(), Some(Trigger::Refine));
+    s.insert(Trigger::PopUp);
+    assert!(!refine_only(s));
+    assert_eq!(s.primary(), Some(Trigger::PopUp));
+}
+
 /// A trajectory of `n` samples over `[0, 1000]` s with phase ends at 333.3, 700 and 1000.
 fn dense(n: usize) -> Trajectory {
     let mut tr = Trajectory::default();

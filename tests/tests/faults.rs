@@ -239,7 +239,8 @@ fn a_deadline_too_short_to_converge_still_gives_a_flagged_plan_in_time() {
     let dir = TempDir::new("deadline");
     let v = vehicle("deadline");
     let budget_ms = 30.0;
-    let cfg = planner_config(dir.path(), 30, 30, "");
+    // A flagged plan is refined (with the same 30 ms here): not this test's subject.
+    let cfg = planner_config(dir.path(), 30, 30, "\n[triggers]\nrefine = false\n");
     let mut p = planner(&cfg, &v, &dir.path().join("planner.log"));
     let mut h = FakeHarness::new(&v);
     assert!(h.wait_until(Duration::from_secs(60), |h| h.status.is_some()));
@@ -264,7 +265,24 @@ fn a_deadline_too_short_to_converge_still_gives_a_flagged_plan_in_time() {
     assert!(first.validate().is_ok());
 
     // A pop-up on the plan ahead: a re-plan under the same deadline.
-    let on = wingman_planning::plan_message::state_at(first, 200.0).unwrap();
+    let first = first.clone();
+    let re = &popup_ahead(&mut h, first);
+    assert_eq!(re.trigger(), Some(Trigger::PopUp));
+    assert!(flagged(re), "quality {:?}", re.quality());
+    assert!(in_time(re), "compute {} ms", re.compute_ms);
+    assert!(
+        (re.start_time_s - (re.created_at_s + budget_ms / 1e3)).abs() < 1e-6,
+        "commit at trigger + budget: {} vs {}",
+        re.start_time_s,
+        re.created_at_s
+    );
+    assert!(p.is_running());
+    assert!(p.terminate(Duration::from_secs(30)).success());
+}
+
+/// At mission time 10 s, a 1.5 km pop-up on `first` 200 s ahead; the re-plan it makes.
+fn popup_ahead(h: &mut FakeHarness, first: Box<Plan>) -> Box<Plan> {
+    let on = wingman_planning::plan_message::state_at(&first, 200.0).unwrap();
     h.set_time(10.0);
     h.send_threat(static_threat(
         90,
@@ -277,18 +295,64 @@ fn a_deadline_too_short_to_converge_still_gives_a_flagged_plan_in_time() {
         "no re-plan: {:?}",
         h.status
     );
-    let re = &h.plans[1];
-    assert_eq!(re.trigger(), Some(Trigger::PopUp));
-    assert!(flagged(re), "quality {:?}", re.quality());
-    assert!(in_time(re), "compute {} ms", re.compute_ms);
-    assert!(
-        (re.start_time_s - (re.created_at_s + budget_ms / 1e3)).abs() < 1e-6,
-        "commit at trigger + budget: {} vs {}",
-        re.start_time_s,
-        re.created_at_s
-    );
-    assert!(p.is_running());
-    assert!(p.terminate(Duration::from_secs(30)).success());
+    h.plans[1].clone()
+}
+
+/// A re-plan whose deadline (10 ms, far below a 3-D NLP solve) leaves the swarm's path is
+/// refined at once: a `Refine` plan follows, from the plan in flight, with the
+/// plan-from-scratch budget (6 s here: its commit is its creation + 6 s), and it is
+/// `Optimal`. With `refine = false` the flagged re-plan stays the plan in flight.
+///
+/// Protection: `refine_due` raised after a plan short of `Optimal` and the budget of a
+/// refinement being the plan budget (with the re-plan budget the refinement is cut at
+/// 10 ms as well and comes out flagged; without the trigger no third plan comes).
+#[test]
+fn a_replan_its_deadline_cut_short_is_refined_with_the_plan_budget() {
+    for refine in [true, false] {
+        let dir = TempDir::new("refine");
+        let v = vehicle("refine");
+        let cfg = dir.path().join("planner.toml");
+        std::fs::write(
+            &cfg,
+            format!(
+                "[budget]\nplan_2d_ms = 2000\nplan_3d_ms = 6000\nreplan_2d_ms = 10\n\
+                 replan_3d_ms = 10\nduty_cycle = 1.0\nduty_window_ms = 60000\n\n\
+                 [status]\nheartbeat_ms = 100\n\n[triggers]\nrefine = {refine}\n"
+            ),
+        )
+        .expect("write planner.toml");
+        let mut p = planner(&cfg, &v, &dir.path().join("planner.log"));
+        let mut h = FakeHarness::new(&v);
+        let sc = bundled("3d-min-time-avoidable").unwrap().unwrap();
+        h.first_plan(&scenario_threats(&sc), tasking_from(&sc, 1), WAIT);
+        let first = h.plans[0].clone();
+        assert_eq!(first.quality(), Some(Quality::Optimal));
+        let re = popup_ahead(&mut h, first);
+        assert_eq!(re.trigger(), Some(Trigger::PopUp));
+        assert_ne!(re.quality(), Some(Quality::Optimal), "a 10 ms 3-D re-plan");
+        if refine {
+            assert!(
+                h.wait_until(WAIT, |h| h.plans.len() >= 3),
+                "no refinement: {:?}",
+                h.status
+            );
+            let refined = &h.plans[2];
+            assert_eq!(refined.trigger(), Some(Trigger::Refine));
+            assert_eq!(refined.quality(), Some(Quality::Optimal));
+            assert!(
+                (refined.start_time_s - (refined.created_at_s + 6.0)).abs() < 1e-6,
+                "commit at creation + the plan budget: {} vs {}",
+                refined.start_time_s,
+                refined.created_at_s
+            );
+            assert!(refined.validate().is_ok());
+        } else {
+            // Nothing follows the flagged re-plan: the planner goes idle on it.
+            assert!(!h.wait_until(Duration::from_secs(3), |h| h.plans.len() >= 3));
+        }
+        assert!(p.is_running());
+        assert!(p.terminate(Duration::from_secs(30)).success());
+    }
 }
 
 /// `kill -9` of the planner mid-flight (harness `--kill-planner-at 100 --restart-after

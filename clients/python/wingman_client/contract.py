@@ -1,4 +1,4 @@
-"""The wingman planner's message contract (protocol 3), as Python ctypes.
+"""The wingman planner's message contract (protocol 4), as Python ctypes.
 
 Generated from the Rust code (`WINGMAN_BLESS=1 cargo test -p wingman-ipc --test contract`);
 do not edit. Layouts are little-endian and `repr(C)` with no implicit padding;
@@ -7,7 +7,7 @@ docs/INTERFACES.md says what each field means.
 
 import ctypes
 
-PROTOCOL_VERSION = 3
+PROTOCOL_VERSION = 4
 MAX_TARGETS = 8
 MAX_PHASES = 9
 MAX_ROUTE_POINTS = 16
@@ -79,6 +79,7 @@ TRIGGER_SCHEDULED_REPLAN = 4
 TRIGGER_DEVIATION = 5
 TRIGGER_EXPIRY = 6
 TRIGGER_RESTART = 7
+TRIGGER_REFINE = 8
 
 # Quality: How good a plan is.
 QUALITY_OPTIMAL = 0

@@ -93,6 +93,9 @@ pub struct TriggerConfig {
     /// is (`Restart`), not from the tasking's start (`Initial`). With an ownship state at
     /// hand it plans at once.
     pub first_plan_wait_ms: u64,
+    /// A plan made short of `Optimal` (a re-plan whose deadline cut the NLP) is planned
+    /// again once from itself with a plan-from-scratch budget (`Refine`).
+    pub refine: bool,
 }
 
 /// Inputs that stop arriving are reported in `PlannerStatus::stale_inputs` (wall clock).
@@ -175,6 +178,7 @@ impl Default for TriggerConfig {
             deviation_vertical_m: 200.0,
             replan_min_lead_s: 1.0,
             first_plan_wait_ms: 300,
+            refine: true,
         }
     }
 }

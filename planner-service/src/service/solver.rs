@@ -18,7 +18,7 @@ use std::time::{Duration, Instant};
 
 use crossbeam::channel::{self, Receiver, RecvTimeoutError, Sender};
 use tracing::{error, info, info_span};
-use wingman_interfaces::Trigger;
+use wingman_interfaces::{Quality, Trigger};
 
 use wingman_planning::clock::{Clock, Deadline};
 use wingman_planning::cuts::{Cut, CutList, CutLog, ReplayCuts};
@@ -236,6 +236,9 @@ fn solve_loop(
     let cut_log: &'static CutLog = Box::leak(Box::new(CutLog::new()));
     // The last plan made, with its id: the plan in flight once the message thread took it.
     let mut last: Option<(u64, FlyingPlan)> = None;
+    // The last plan the NLP made (`Optimal` or `Feasible`), with its id: a re-plan of a
+    // plan in flight that is the swarm's path starts from it instead.
+    let mut solved: Option<(u64, FlyingPlan)> = None;
     let threads = settings.swarm.threads.max(settings.threads).max(1) as u32;
     for request in requests.iter() {
         let SolveRequest { problem, ticket } = request;
@@ -266,8 +269,7 @@ fn solve_loop(
         .with_cuts(cut_log);
         let flying = ticket
             .warm_from
-            .and_then(|id| last.as_ref().filter(|(made, _)| *made == id))
-            .map(|(_, f)| f);
+            .and_then(|id| warm_start(id, last.as_ref(), solved.as_ref()));
         let outcome = match catch_unwind(AssertUnwindSafe(|| match flying {
             Some(f) => planner.replan(&problem, settings, deadline, f),
             None => planner.plan(&problem, settings, deadline),
@@ -311,10 +313,12 @@ fn solve_loop(
         }
         drop(_entered);
         if let Ok(o) = &outcome {
-            last = Some((
-                ticket.plan_id,
-                FlyingPlan::new(&problem, o.trajectory.clone()).with_solution(o.solution.clone()),
-            ));
+            let made =
+                FlyingPlan::new(&problem, o.trajectory.clone()).with_solution(o.solution.clone());
+            if matches!(o.quality, Quality::Optimal | Quality::Feasible) {
+                solved = Some((ticket.plan_id, made.clone()));
+            }
+            last = Some((ticket.plan_id, made));
         }
         let result = SolveResult {
             problem,
@@ -329,6 +333,23 @@ fn solve_loop(
             return;
         }
         wake();
+    }
+}
+
+/// The plan a re-plan of plan `id` (the plan in flight) starts from: that plan, or if it
+/// is not the NLP's (the swarm's path of a re-plan its deadline cut: a start far from any
+/// optimum, and from which a 2-D re-plan of a 3000 s mission did not converge in 500 ms)
+/// the last plan the NLP made, cut at the new start as well, with the world it was made
+/// for (threats it did not know are new to it). `None` if plan `id` is not the last made.
+fn warm_start<'a>(
+    id: u64,
+    last: Option<&'a (u64, FlyingPlan)>,
+    solved: Option<&'a (u64, FlyingPlan)>,
+) -> Option<&'a FlyingPlan> {
+    let (made, flying) = last.filter(|(made, _)| *made == id)?;
+    match solved {
+        Some((at, nlp)) if at < made => Some(nlp),
+        _ => Some(flying),
     }
 }
 

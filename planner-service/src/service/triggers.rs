@@ -15,9 +15,11 @@
 //!   `t_r` ([`scheduled_due`]);
 //! - the tracker's deviation from the plan beyond a bound ([`deviation_exceeded`]);
 //! - the plan expiring with no successor, or the tracker flying a safe hold
-//!   ([`expiry_due`]).
+//!   ([`expiry_due`]);
+//! - a plan made short of `Optimal` (its deadline cut the NLP), refined once from itself
+//!   with a plan-from-scratch budget ([`refine_due`]).
 
-use wingman_interfaces::{LeadRoute, OwnshipState, Tasking, Trigger};
+use wingman_interfaces::{LeadRoute, OwnshipState, Quality, Tasking, Trigger};
 
 use wingman_planning::estimation::MovingThreat;
 use wingman_planning::replan::{self, PlanPoint, PopupHit, ReplanTime};
@@ -200,6 +202,22 @@ pub fn expiry_due(now: f64, plan: &PlanWindow, lead_s: f64, holding: bool) -> bo
     !plan.reaches_end() && now >= plan.valid_until_s - lead_s - TIME_TOLERANCE_S
 }
 
+/// Whether a plan just made is refined: it fell short of `Optimal` (a re-plan's short
+/// budget cut its NLP, leaving the swarm's path or an unconverged solution to fly, which
+/// may miss the end by hundreds of metres) and is not itself a refinement (one attempt,
+/// so a mission the NLP cannot solve does not plan on end). The refinement re-plans the
+/// plan in flight with the budget of a plan from scratch ([`refine_only`]): the aircraft
+/// flies the short plan meanwhile.
+pub fn refine_due(enabled: bool, made: Quality, trigger: Trigger) -> bool {
+    enabled && made != Quality::Optimal && trigger != Trigger::Refine
+}
+
+/// Whether the triggers `set` ask only for a refinement (its budget is a plan from
+/// scratch's, though it starts from the plan in flight).
+pub fn refine_only(set: TriggerSet) -> bool {
+    set.only_of(&[Trigger::Refine]) && set.contains(Trigger::Refine)
+}
+
 /// Whether the first plan of a tasking is a restart: the tracker already flies a plan
 /// (of a predecessor process), or the ownship's clock is past the tasking's start.
 pub fn first_plan_trigger(tasking: &Tasking, ownship: Option<&OwnshipState>) -> Trigger {
@@ -214,7 +232,7 @@ pub fn first_plan_trigger(tasking: &Tasking, ownship: Option<&OwnshipState>) -> 
 pub struct TriggerSet(u32);
 
 /// Triggers in the order the plan message names them when several are pending.
-const PRIORITY: [Trigger; 8] = [
+const PRIORITY: [Trigger; 9] = [
     Trigger::Initial,
     Trigger::Restart,
     Trigger::Tasking,
@@ -223,6 +241,7 @@ const PRIORITY: [Trigger; 8] = [
     Trigger::Deviation,
     Trigger::ScheduledReplan,
     Trigger::Expiry,
+    Trigger::Refine,
 ];
 
 impl TriggerSet {

@@ -8,6 +8,7 @@ use wingman_interfaces::{Header, SENDER_PLANNER, Trigger};
 use super::lifecycle::{FirstPlan, PlanLifecycle};
 use super::{FIRST_PLAN_RETRY, MessageLoop};
 use crate::service::solver::{SolveResult, Ticket};
+use crate::service::triggers;
 use crate::service::world::{self, ThreatSlot};
 use wingman_planning::cuts::Cut;
 use wingman_planning::hybrid::PlanOutcome;
@@ -155,6 +156,13 @@ impl MessageLoop {
             next_replan_s = self.current.next_replan(),
             "plan published"
         );
+        if triggers::refine_due(self.cfg.triggers.refine, o.quality, ticket.trigger) {
+            info!(
+                quality = o.quality.name(),
+                "plan short of optimal: refine it"
+            );
+            self.raise(Trigger::Refine);
+        }
     }
 
     fn publish_plan(&mut self) {
