@@ -80,7 +80,7 @@ wire_enum! {
         /// The planner restarted and plans from the current ownship state.
         Restart = 7,
         /// The plan in flight fell short of `Optimal` (a re-plan its deadline cut): it is
-        /// planned again, from the last plan the NLP made, with a plan-from-scratch budget.
+        /// planned again, from the last plan the NLP made, with the longer refinement budget.
         Refine = 8,
     }
 }

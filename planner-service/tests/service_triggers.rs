@@ -253,6 +253,21 @@ fn expiry_fires_before_a_cut_short_plan_ends_and_not_at_the_missions_end() {
 }
 
 #[test]
+fn a_hold_counts_against_the_plan_it_replaced_and_a_plan_the_tracker_did_not_take() {
+    let mut o = ownship(3, 0.0, 0.0);
+    o.time_s = 604.8;
+    o.flags |= OWNSHIP_HOLDING;
+    // The tracker holds after flying plan 3, or past plan 4's start without taking it.
+    assert!(holds_instead_of(&o, 3, 0.0));
+    assert!(holds_instead_of(&o, 4, 604.8));
+    // Near misses: plan 4 starts after the hold was reported (it answers the hold); the
+    // tracker flies its plan (no hold).
+    assert!(!holds_instead_of(&o, 4, 605.1));
+    o.flags &= !OWNSHIP_HOLDING;
+    assert!(!holds_instead_of(&o, 3, 0.0));
+}
+
+#[test]
 fn the_first_plan_is_a_restart_when_the_mission_is_under_way() {
     let t = tasking(1);
     assert_eq!(first_plan_trigger(&t, None), Trigger::Initial);
@@ -280,7 +295,7 @@ fn pending_triggers_name_the_plan_by_priority() {
 }
 
 #[test]
-fn a_plan_short_of_optimal_is_refined_once_with_the_plan_budget() {
+fn a_plan_short_of_optimal_is_refined_once_with_its_own_budget() {
     // Fires: every quality short of `Optimal`, whatever re-plan made it.
     for q in [Quality::Feasible, Quality::SwarmOnly, Quality::Degraded] {
         for t in [

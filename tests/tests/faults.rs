@@ -300,14 +300,14 @@ fn popup_ahead(h: &mut FakeHarness, first: Box<Plan>) -> Box<Plan> {
 
 /// A re-plan whose deadline (10 ms, far below a 3-D NLP solve) leaves the swarm's path is
 /// refined at once: a `Refine` plan follows, from the plan in flight, with the
-/// plan-from-scratch budget (6 s here: its commit is its creation + 6 s), and it is
-/// `Optimal`. With `refine = false` the flagged re-plan stays the plan in flight.
+/// refinement budget (4 s here: its commit is its creation + 4 s), and it is `Optimal`.
+/// With `refine = false` the flagged re-plan stays the plan in flight.
 ///
 /// Protection: `refine_due` raised after a plan short of `Optimal` and the budget of a
-/// refinement being the plan budget (with the re-plan budget the refinement is cut at
-/// 10 ms as well and comes out flagged; without the trigger no third plan comes).
+/// refinement being its own (with the re-plan budget the refinement is cut at 10 ms as
+/// well and comes out flagged; without the trigger no third plan comes).
 #[test]
-fn a_replan_its_deadline_cut_short_is_refined_with_the_plan_budget() {
+fn a_replan_its_deadline_cut_short_is_refined_with_the_refinement_budget() {
     for refine in [true, false] {
         let dir = TempDir::new("refine");
         let v = vehicle("refine");
@@ -316,7 +316,7 @@ fn a_replan_its_deadline_cut_short_is_refined_with_the_plan_budget() {
             &cfg,
             format!(
                 "[budget]\nplan_2d_ms = 2000\nplan_3d_ms = 6000\nreplan_2d_ms = 10\n\
-                 replan_3d_ms = 10\nduty_cycle = 1.0\nduty_window_ms = 60000\n\n\
+                 replan_3d_ms = 10\nrefine_3d_ms = 4000\nduty_cycle = 1.0\nduty_window_ms = 60000\n\n\
                  [status]\nheartbeat_ms = 100\n\n[triggers]\nrefine = {refine}\n"
             ),
         )
@@ -340,8 +340,8 @@ fn a_replan_its_deadline_cut_short_is_refined_with_the_plan_budget() {
             assert_eq!(refined.trigger(), Some(Trigger::Refine));
             assert_eq!(refined.quality(), Some(Quality::Optimal));
             assert!(
-                (refined.start_time_s - (refined.created_at_s + 6.0)).abs() < 1e-6,
-                "commit at creation + the plan budget: {} vs {}",
+                (refined.start_time_s - (refined.created_at_s + 4.0)).abs() < 1e-6,
+                "commit at creation + the refinement budget: {} vs {}",
                 refined.start_time_s,
                 refined.created_at_s
             );

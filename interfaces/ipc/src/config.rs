@@ -56,6 +56,11 @@ pub struct BudgetConfig {
     pub replan_2d_ms: u64,
     /// Deadline of a 3-D re-plan of the plan in flight, ms.
     pub replan_3d_ms: u64,
+    /// Deadline of a 2-D refinement (`Refine`: a plan published short of `Optimal`
+    /// planned again at once), ms; at most `plan_2d_ms` (a larger value is cut to it).
+    pub refine_2d_ms: u64,
+    /// Deadline of a 3-D refinement, ms; at most `plan_3d_ms`.
+    pub refine_3d_ms: u64,
     /// Least wall-clock time between the starts of two plans, ms.
     pub min_spacing_ms: u64,
     /// Share of one core the planner may spend planning over the sliding window (0–1].
@@ -163,6 +168,8 @@ impl Default for BudgetConfig {
             plan_3d_ms: 2500,
             replan_2d_ms: 100,
             replan_3d_ms: 300,
+            refine_2d_ms: 500,
+            refine_3d_ms: 1200,
             min_spacing_ms: 250,
             duty_cycle: 0.5,
             duty_window_ms: 10_000,
@@ -265,6 +272,12 @@ impl ServiceConfig {
         if b.replan_3d_ms == 0 {
             return bad("budget.replan_3d_ms", "must be positive".into());
         }
+        if b.refine_2d_ms == 0 {
+            return bad("budget.refine_2d_ms", "must be positive".into());
+        }
+        if b.refine_3d_ms == 0 {
+            return bad("budget.refine_3d_ms", "must be positive".into());
+        }
         if self.solver.threads == 0 {
             return bad("solver.threads", "must be at least 1".into());
         }
@@ -354,6 +367,14 @@ impl ServiceConfig {
         Duration::from_millis(match model {
             Model::TwoD => self.budget.replan_2d_ms,
             Model::ThreeD => self.budget.replan_3d_ms,
+        })
+    }
+
+    /// Deadline of a refinement of a plan of `model` (`Refine`): at most the plan budget.
+    pub fn refine_budget(&self, model: Model) -> Duration {
+        Duration::from_millis(match model {
+            Model::TwoD => self.budget.refine_2d_ms.min(self.budget.plan_2d_ms),
+            Model::ThreeD => self.budget.refine_3d_ms.min(self.budget.plan_3d_ms),
         })
     }
 

@@ -326,7 +326,7 @@ impl MessageLoop {
     }
 
     /// Budget of a plan of the current tasking's model for the triggers `set`: a re-plan
-    /// of the plan in flight's, or a plan from scratch's (also a refinement's).
+    /// of the plan in flight's, a refinement's, or a plan from scratch's.
     fn budget(&self, set: TriggerSet) -> Duration {
         let model = self
             .world
@@ -334,7 +334,9 @@ impl MessageLoop {
             .as_ref()
             .and_then(Tasking::model)
             .unwrap_or(Model::ThreeD);
-        if self.replans_in_flight(set) && !triggers::refine_only(set) {
+        if self.replans_in_flight(set) && triggers::refine_only(set) {
+            self.cfg.refine_budget(model)
+        } else if self.replans_in_flight(set) {
             self.cfg.replan_budget(model)
         } else {
             self.cfg.plan_budget(model)

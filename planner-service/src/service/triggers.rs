@@ -16,8 +16,8 @@
 //! - the tracker's deviation from the plan beyond a bound ([`deviation_exceeded`]);
 //! - the plan expiring with no successor, or the tracker flying a safe hold
 //!   ([`expiry_due`]);
-//! - a plan made short of `Optimal` (its deadline cut the NLP), refined once from itself
-//!   with a plan-from-scratch budget ([`refine_due`]).
+//! - a plan made short of `Optimal` (its deadline cut the NLP), refined once with a
+//!   longer budget ([`refine_due`]).
 
 use wingman_interfaces::{LeadRoute, OwnshipState, Quality, Tasking, Trigger};
 
@@ -191,6 +191,18 @@ impl PlanWindow {
     }
 }
 
+/// Whether the tracker flies a safe hold instead of plan `plan_id` (which starts at
+/// `plan_start_s`): it holds after flying that plan, or it still holds at or after that
+/// plan's start (it did not take it). A hold reported before a newer plan starts is the
+/// older plan's, which the newer one answers: counting it again for every newer plan
+/// re-plans on end while mission time stands still (a lock-step harness waits for the
+/// planner to be idle before it moves the clock and the tracker on).
+pub fn holds_instead_of(ownship: &OwnshipState, plan_id: u64, plan_start_s: f64) -> bool {
+    ownship.holding()
+        && (ownship.plan_id == plan_id
+            || (ownship.plan_id < plan_id && ownship.time_s >= plan_start_s - TIME_TOLERANCE_S))
+}
+
 /// Whether the plan expires with no successor: at mission time `now` it is within one
 /// plan budget (`lead_s`) of `valid_until` while cut short of its end, or the tracker
 /// reports flying a safe hold. A plan that runs to its end (the mission's end) does not
@@ -206,14 +218,14 @@ pub fn expiry_due(now: f64, plan: &PlanWindow, lead_s: f64, holding: bool) -> bo
 /// budget cut its NLP, leaving the swarm's path or an unconverged solution to fly, which
 /// may miss the end by hundreds of metres) and is not itself a refinement (one attempt,
 /// so a mission the NLP cannot solve does not plan on end). The refinement re-plans the
-/// plan in flight with the budget of a plan from scratch ([`refine_only`]): the aircraft
-/// flies the short plan meanwhile.
+/// plan in flight with its own budget, longer than a re-plan's ([`refine_only`]): the
+/// aircraft flies the short plan meanwhile.
 pub fn refine_due(enabled: bool, made: Quality, trigger: Trigger) -> bool {
     enabled && made != Quality::Optimal && trigger != Trigger::Refine
 }
 
-/// Whether the triggers `set` ask only for a refinement (its budget is a plan from
-/// scratch's, though it starts from the plan in flight).
+/// Whether the triggers `set` ask only for a refinement (it has its own budget, between a
+/// re-plan's and a plan from scratch's).
 pub fn refine_only(set: TriggerSet) -> bool {
     set.only_of(&[Trigger::Refine]) && set.contains(Trigger::Refine)
 }

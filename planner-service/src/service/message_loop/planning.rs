@@ -187,7 +187,7 @@ impl MessageLoop {
             .world
             .ownship
             .as_ref()
-            .is_some_and(|o| o.holding() && o.plan_id <= id);
+            .is_some_and(|o| triggers::holds_instead_of(o, id, self.current.start_time_s));
         let window = PlanWindow {
             start_s: self.current.start_time_s,
             valid_until_s: self.current.valid_until_s,
