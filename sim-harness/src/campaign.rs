@@ -7,6 +7,7 @@
 //! - [`run`]: a campaign or one shard of it (`--shard i/n`), `jobs` flights at a time,
 //!   `results.json` written as missions land;
 //! - [`outcome`]: one mission's numbers and the criteria it misses;
+//! - [`independent`]: the independent solver (CasADi + IPOPT) on every k-th take-off;
 //! - [`merge`]: one campaign's results from its shards';
 //! - [`summary`], [`charts`]: `report.md`, `summary.json` and the CDF charts;
 //! - [`progress`]: the progress line with the time left.
@@ -16,6 +17,7 @@
 
 pub mod charts;
 pub mod generate;
+pub mod independent;
 pub mod kind;
 pub mod layout;
 pub mod merge;

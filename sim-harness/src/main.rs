@@ -132,6 +132,26 @@ struct CampaignArgs {
     /// Do not plan the take-offs with the yardstick (no gap is measured).
     #[arg(long)]
     no_yardstick: bool,
+    /// Plan the take-off of every K-th mission (index 0, K, 2K, ...) also with the
+    /// independent solver (CasADi + IPOPT, needs python3 with casadi, numpy, scipy); 0:
+    /// none.
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    independent_every: usize,
+    /// The independent solver's script.
+    #[arg(
+        long,
+        value_name = "FILE",
+        default_value = "tools/yardstick/ipopt_multistart.py"
+    )]
+    independent_solver: PathBuf,
+    /// An argument passed to the independent solver (repeatable), e.g.
+    /// `--independent-arg=--bulges=0` for its straight start only.
+    #[arg(
+        long = "independent-arg",
+        value_name = "ARG",
+        allow_hyphen_values = true
+    )]
+    independent_args: Vec<String>,
     /// Planner configuration of the flights (default: the deployment defaults).
     #[arg(long, value_name = "FILE")]
     planner_config: Option<PathBuf>,
@@ -375,6 +395,13 @@ fn campaign_options(a: &CampaignArgs) -> Result<campaign::run::RunOptions, Strin
     if a.yardstick_runs == 0 {
         return Err("--yardstick-runs must be at least 1 (or --no-yardstick)".into());
     }
+    if a.independent_every > 0 && !a.independent_solver.is_file() {
+        return Err(format!(
+            "--independent-solver {}: no such file (run from the repository's root, or give \
+             its path)",
+            a.independent_solver.display()
+        ));
+    }
     let shard = match &a.shard {
         Some(s) => Shard::parse(s)?,
         None => Shard::WHOLE,
@@ -404,12 +431,15 @@ fn campaign_options(a: &CampaignArgs) -> Result<campaign::run::RunOptions, Strin
                 seed: 1,
             }),
             planner_config: a.planner_config.as_ref().map(|p| p.display().to_string()),
+            independent_every: a.independent_every,
+            independent_args: a.independent_args.clone(),
         },
         shard,
         jobs: a.jobs,
         out_dir: out,
         planner_config,
         keep_all: a.keep_all,
+        independent_solver: a.independent_solver.clone(),
         progress: !a.quiet,
     })
 }

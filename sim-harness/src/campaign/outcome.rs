@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::independent::IndependentNumbers;
 use super::kind::MissionKind;
 use crate::report::{REACHED_M, Report};
 
@@ -76,6 +77,13 @@ pub struct MissionOutcome {
     /// Why the yardstick could not plan the take-off (the flight's numbers stand).
     #[serde(default)]
     pub yardstick_error: Option<String>,
+    /// The independent solver's take-off, on the missions it plans
+    /// ([`super::independent::selected`]).
+    #[serde(default)]
+    pub independent: Option<IndependentNumbers>,
+    /// Why the independent solver gave no take-off there.
+    #[serde(default)]
+    pub independent_error: Option<String>,
     /// The criteria it missed, in words (empty: it meets them all).
     pub misses: Vec<String>,
     /// Its folder under the campaign's, kept when it failed or its take-off plan is
@@ -196,6 +204,8 @@ impl MissionOutcome {
             flight: None,
             yardstick: None,
             yardstick_error: None,
+            independent: None,
+            independent_error: None,
             misses: vec!["not flown".into()],
             kept: None,
             wall_s: 0.0,
@@ -304,6 +314,8 @@ mod tests {
                 compute_s: 1.0,
             }),
             yardstick_error: None,
+            independent: None,
+            independent_error: None,
             misses: Vec::new(),
             kept: None,
             wall_s: 1.0,

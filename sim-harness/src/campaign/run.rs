@@ -16,8 +16,10 @@ use wingman_planning::clock::MonotonicClock;
 use wingman_planning::hybrid::{Exhaustive, plan_exhaustive};
 use wingman_planning::problem::Problem;
 use wingman_planning::scenario::Scenario;
+use wingman_planning::trajectory::Trajectory;
 
 use super::generate::{Drawn, draw};
+use super::independent::{self, IndependentNumbers, PlanJson};
 use super::kind::Filter;
 use super::outcome::{FlightNumbers, MissionOutcome, YardstickNumbers, finite};
 use super::progress::Progress;
@@ -86,6 +88,12 @@ pub struct CampaignSpec {
     /// The planner configuration file the flights used (`None`: the deployment defaults).
     #[serde(default)]
     pub planner_config: Option<String>,
+    /// The independent solver plans the take-off of every this many missions (0: none).
+    #[serde(default)]
+    pub independent_every: usize,
+    /// Arguments passed to the independent solver.
+    #[serde(default)]
+    pub independent_args: Vec<String>,
 }
 
 /// The results file of a campaign or of some of its shards.
@@ -123,6 +131,8 @@ pub struct RunOptions {
     pub planner_config: ServiceConfig,
     /// Keep every mission's folder, not only the failed and outlying ones.
     pub keep_all: bool,
+    /// The independent solver's script (`tools/yardstick/ipopt_multistart.py`).
+    pub independent_solver: PathBuf,
     pub progress: bool,
 }
 
@@ -215,13 +225,18 @@ fn fly_mission(
     let mut outcome =
         MissionOutcome::not_flown(drawn.index, &drawn.name, &drawn.kind, String::new());
     match fly_and_judge(opts, drawn, &dir, clock) {
-        Ok((flight, yardstick)) => {
+        Ok(judged) => {
             outcome.error = None;
-            outcome.misses = flight.misses(&drawn.kind);
-            outcome.flight = Some(flight);
-            match yardstick {
+            outcome.misses = judged.flight.misses(&drawn.kind);
+            outcome.flight = Some(judged.flight);
+            match judged.yardstick {
                 Some(Ok(y)) => outcome.yardstick = Some(y),
                 Some(Err(e)) => outcome.yardstick_error = Some(e),
+                None => {}
+            }
+            match judged.independent {
+                Some(Ok(i)) => outcome.independent = Some(i),
+                Some(Err(e)) => outcome.independent_error = Some(e),
                 None => {}
             }
         }
@@ -236,14 +251,22 @@ fn fly_mission(
     outcome
 }
 
-/// The flight's numbers and the yardstick's take-off plan of one mission (or why the
-/// yardstick could not plan it: the flight stands either way).
+/// What one mission measured: the flight, and the take-off by the yardstick and the
+/// independent solver (or why they could not plan it: the flight stands either way).
+struct Judged {
+    flight: FlightNumbers,
+    yardstick: Option<Result<YardstickNumbers, String>>,
+    independent: Option<Result<IndependentNumbers, String>>,
+}
+
+/// Flies one mission and plans its take-off with the yardstick and, if it is one of
+/// theirs, the independent solver.
 fn fly_and_judge(
     opts: &RunOptions,
     drawn: &Drawn,
     dir: &Path,
     clock: &'static MonotonicClock,
-) -> anyhow::Result<(FlightNumbers, Option<Result<YardstickNumbers, String>>)> {
+) -> anyhow::Result<Judged> {
     use anyhow::Context;
     std::fs::create_dir_all(dir).with_context(|| format!("create {}", dir.display()))?;
     let file = dir.join(format!("{}.toml", drawn.name));
@@ -264,24 +287,76 @@ fn fly_and_judge(
         .yardstick
         .as_ref()
         .map(|spec| yardstick(&scenario, spec, clock).map_err(|e| format!("{e:#}")));
-    Ok((numbers, yardstick))
+    let independent = independent::selected(drawn.index, opts.spec.independent_every).then(|| {
+        let yardstick_plan = yardstick.as_ref().and_then(|y| y.as_ref().ok());
+        independent(
+            opts,
+            &scenario,
+            &file,
+            &flight,
+            yardstick_plan.map(|(_, tr)| tr),
+        )
+    });
+    Ok(Judged {
+        flight: numbers,
+        yardstick: yardstick.map(|y| y.map(|(numbers, _)| numbers)),
+        independent,
+    })
 }
 
-/// The yardstick's take-off plan of `scenario`.
+/// The yardstick's take-off plan of `scenario`: its numbers and its path.
 fn yardstick(
     scenario: &Scenario,
     spec: &YardstickSpec,
     clock: &'static MonotonicClock,
-) -> anyhow::Result<YardstickNumbers> {
+) -> anyhow::Result<(YardstickNumbers, Trajectory)> {
     let problem = Problem::from_scenario(scenario)?;
     let o = plan_exhaustive(&problem, &spec.exhaustive(), clock)?;
-    Ok(YardstickNumbers {
+    let numbers = YardstickNumbers {
         cost: finite(o.best.cost),
         quality: o.best.quality.name().to_string(),
         run_costs: o.runs.iter().map(|(_, c)| finite(*c)).collect(),
         cuts: o.cuts,
         compute_s: o.elapsed.as_secs_f64(),
-    })
+    };
+    Ok((numbers, o.best.trajectory))
+}
+
+/// The independent solver's take-off of the mission in `file`, started also from the
+/// flight's take-off plan and the yardstick's path (written beside `file`).
+fn independent(
+    opts: &RunOptions,
+    scenario: &Scenario,
+    file: &Path,
+    flight: &mission::Flight,
+    yardstick: Option<&Trajectory>,
+) -> Result<IndependentNumbers, String> {
+    let dir = file.parent().unwrap_or(Path::new("."));
+    let mut starts = Vec::new();
+    let take_off = flight
+        .plans
+        .first()
+        .filter(|p| p.plan.trigger() == Some(wingman_interfaces::Trigger::Initial));
+    if let Some(p) = take_off {
+        let path = dir.join("default_plan.json");
+        PlanJson::of_plan(&p.plan, scenario.model)
+            .write(&path)
+            .map_err(|e| format!("{e:#}"))?;
+        starts.push(path);
+    }
+    if let Some(tr) = yardstick {
+        let path = dir.join("yardstick_plan.json");
+        PlanJson::of_trajectory(tr, scenario.model)
+            .write(&path)
+            .map_err(|e| format!("{e:#}"))?;
+        starts.push(path);
+    }
+    independent::solve(
+        &opts.independent_solver,
+        &opts.spec.independent_args,
+        file,
+        &starts,
+    )
 }
 
 /// Writes `results.json` (through a temporary file, so a reader never sees half of it).

@@ -10,6 +10,7 @@ use std::path::Path;
 use serde_json::json;
 
 use super::charts::{Cdf, Series, draw_cdf};
+use super::independent;
 use super::kind::{Feature, OBJECTIVES};
 use super::outcome::{GAP_TOL, MissionOutcome};
 use super::progress::clock_time;
@@ -107,6 +108,12 @@ pub fn command(r: &CampaignResults) -> String {
             );
         }
     }
+    if s.independent_every > 0 {
+        let _ = write!(c, " --independent-every {}", s.independent_every);
+        for arg in &s.independent_args {
+            let _ = write!(c, " --independent-arg={arg}");
+        }
+    }
     c
 }
 
@@ -146,6 +153,7 @@ pub fn markdown(r: &CampaignResults) -> String {
     write_errors(&mut s, r);
     write_plans(&mut s, r);
     write_gaps(&mut s, r);
+    independent::write_section(&mut s, r);
     write_failures(&mut s, r);
     s
 }
@@ -500,6 +508,14 @@ pub fn summary_json(r: &CampaignResults) -> serde_json::Value {
         })).collect::<Vec<_>>(),
         "outlying": r.outcomes.iter().filter(|o| o.gap().is_some_and(|g| g > GAP_TOL)).map(|o| json!({
             "name": o.name, "gap": o.gap(), "kept": o.kept,
+        })).collect::<Vec<_>>(),
+        "independent": r.outcomes.iter().filter(|o| independent::selected(o.index, r.spec.independent_every)).map(|o| json!({
+            "name": o.name,
+            "cost": o.independent.as_ref().map(|i| i.cost),
+            "start": o.independent.as_ref().map(|i| &i.start),
+            "error": o.independent_error,
+            "default_vs_independent": o.default_vs_independent(),
+            "yardstick_vs_independent": o.yardstick_vs_independent(),
         })).collect::<Vec<_>>(),
     })
 }
