@@ -99,10 +99,11 @@ fn a_ci_sized_campaign_meets_its_bars_and_four_merged_shards_give_its_outcomes()
         assert_eq!(y.cuts, 0, "{}: the yardstick's budget cut it", o.name);
         assert!(o.gap().is_some(), "{}", o.name);
     }
-    // What it measures. The bars (≥ 99 % within the criteria, ≥ 98 % within 0.5 %
-    // of the yardstick) are not met yet (docs/CAMPAIGN.md lists the misses); these are
-    // the floors of the planner as it stands, a few missions below what this campaign
-    // measured on the 2-core machine (26 and 23 of 30), for a slower machine's cuts.
+    // What it measures. The yardstick bar (≥ 98 % within 0.5 % of the yardstick)
+    // is not met yet (docs/CAMPAIGN.md lists the misses); these are the floors of the
+    // planner as it stands, below what this campaign measured on the 2-core machine (30
+    // and 23 of 30; 26 meeting the criteria before re-plans short of optimal were
+    // refined), for a slower machine's cuts.
     let meeting = r.outcomes.iter().filter(|o| o.meets_criteria()).count();
     let within = r
         .outcomes
@@ -111,7 +112,7 @@ fn a_ci_sized_campaign_meets_its_bars_and_four_merged_shards_give_its_outcomes()
         .count();
     let report_md = std::fs::read_to_string(whole.join("report.md")).unwrap();
     assert!(
-        meeting >= 24,
+        meeting >= 28,
         "{meeting} of {COUNT} meet the criteria\n{report_md}"
     );
     assert!(
