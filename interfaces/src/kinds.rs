@@ -79,8 +79,9 @@ wire_enum! {
         Expiry = 6,
         /// The planner restarted and plans from the current ownship state.
         Restart = 7,
-        /// The plan in flight fell short of `Optimal` (a re-plan its deadline cut): it is
-        /// planned again, from the last plan the NLP made, with the longer refinement budget.
+        /// The plan in flight fell short of `Optimal` (its deadline cut it: mostly a short
+        /// re-plan): it is planned again, from the last plan the NLP made, with the longer
+        /// refinement budget.
         Refine = 8,
     }
 }

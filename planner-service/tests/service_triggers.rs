@@ -311,7 +311,7 @@ fn a_plan_short_of_optimal_is_refined_once_with_its_own_budget() {
     assert!(!refine_due(true, Quality::Optimal, Trigger::PopUp));
     assert!(!refine_due(true, Quality::SwarmOnly, Trigger::Refine));
     assert!(!refine_due(false, Quality::SwarmOnly, Trigger::PopUp));
-    // Its budget is the plan budget only while nothing else is pending.
+    // Its budget is the refinement's only while nothing else is pending.
     let mut s = TriggerSet::default();
     assert!(!refine_only(s));
     s.insert(Trigger::Refine);

@@ -395,12 +395,11 @@ fn campaign_options(a: &CampaignArgs) -> Result<campaign::run::RunOptions, Strin
     if a.yardstick_runs == 0 {
         return Err("--yardstick-runs must be at least 1 (or --no-yardstick)".into());
     }
-    if a.independent_every > 0 && !a.independent_solver.is_file() {
-        return Err(format!(
-            "--independent-solver {}: no such file (run from the repository's root, or give \
-             its path)",
-            a.independent_solver.display()
-        ));
+    if a.independent_every == 0 && !a.independent_args.is_empty() {
+        return Err("--independent-arg needs --independent-every K (K >= 1)".into());
+    }
+    if a.independent_every > 0 {
+        independent_solver_ready(&a.independent_solver)?;
     }
     let shard = match &a.shard {
         Some(s) => Shard::parse(s)?,
@@ -442,6 +441,29 @@ fn campaign_options(a: &CampaignArgs) -> Result<campaign::run::RunOptions, Strin
         independent_solver: a.independent_solver.clone(),
         progress: !a.quiet,
     })
+}
+
+/// Whether the independent solver can run: its script is there, and python3 imports what
+/// it needs (else every chosen mission would fail after its flight).
+fn independent_solver_ready(script: &std::path::Path) -> Result<(), String> {
+    if !script.is_file() {
+        return Err(format!(
+            "--independent-solver {}: no such file (run from the repository's root, or give \
+             its path)",
+            script.display()
+        ));
+    }
+    let imports = std::process::Command::new("python3")
+        .args(["-c", "import casadi, numpy, scipy"])
+        .output();
+    match imports {
+        Ok(o) if o.status.success() => Ok(()),
+        _ => Err(
+            "--independent-every needs python3 with casadi, numpy and scipy: \
+             python3 -m pip install -r tools/yardstick/requirements.txt"
+                .into(),
+        ),
+    }
 }
 
 fn campaign(a: &CampaignArgs) -> ExitCode {

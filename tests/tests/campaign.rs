@@ -266,8 +266,8 @@ fn a_failed_mission_is_kept_and_flown_alone_fails_the_same_way() {
 
 /// The independent solver (`tools/yardstick/ipopt_multistart.py`: CasADi + IPOPT on a
 /// transcription of its own, judged by the customer's judge) on the take-offs of a small
-/// campaign: it converges on each, from its straight start, the default plan and the
-/// yardstick's, and finds no basin better than the yardstick's by more than the gap
+/// campaign: on each, some of its starts (its straight path, the default plan and the
+/// yardstick's) converge, and finds no basin better than the yardstick's by more than the gap
 /// tolerance (0.5 %, or 1e-4 on costs below 0.02). Mission 1 of seed 3 is one whose
 /// default take-off plan is 1.6 % above the yardstick's: the independent solver confirms
 /// the yardstick's basin (measured 68.7634 against 68.7684). A missing script is refused

@@ -299,7 +299,7 @@ fn popup_ahead(h: &mut FakeHarness, first: Box<Plan>) -> Box<Plan> {
 }
 
 /// A re-plan whose deadline (10 ms, far below a 3-D NLP solve) leaves the swarm's path is
-/// refined at once: a `Refine` plan follows, from the plan in flight, with the
+/// refined at once: a `Refine` plan follows, from the last NLP plan (the take-off's), with the
 /// refinement budget (4 s here: its commit is its creation + 4 s), and it is `Optimal`.
 /// With `refine = false` the flagged re-plan stays the plan in flight.
 ///

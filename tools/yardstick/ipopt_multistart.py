@@ -290,6 +290,18 @@ def solve(sc, guess, nodes_per_s, max_iter):
     }
 
 
+def finite_json(v):
+    """`v` with every non-finite float as None: JSON has no NaN, and a strict reader
+    (the campaign's) refuses the whole document for one."""
+    if isinstance(v, float):
+        return v if math.isfinite(v) else None
+    if isinstance(v, dict):
+        return {k: finite_json(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [finite_json(x) for x in v]
+    return v
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scenario")
@@ -311,7 +323,8 @@ def main(argv=None):
         results.append(r)
     ok = [r for r in results if r.get("status") == "Solve_Succeeded" and math.isfinite(r.get("judged_cost", math.nan))]
     best = min(ok, key=lambda r: r["judged_cost"]) if ok else None
-    print(json.dumps({"scenario": sc.name, "starts": results, "best": best}, indent=2))
+    doc = finite_json({"scenario": sc.name, "starts": results, "best": best})
+    print(json.dumps(doc, indent=2, allow_nan=False))
     return 0 if best else 1
 
 

@@ -57,9 +57,9 @@ pub struct BudgetConfig {
     /// Deadline of a 3-D re-plan of the plan in flight, ms.
     pub replan_3d_ms: u64,
     /// Deadline of a 2-D refinement (`Refine`: a plan published short of `Optimal`
-    /// planned again at once), ms; at most `plan_2d_ms` (a larger value is cut to it).
+    /// planned again at once), ms; taken between `replan_2d_ms` and `plan_2d_ms`.
     pub refine_2d_ms: u64,
-    /// Deadline of a 3-D refinement, ms; at most `plan_3d_ms`.
+    /// Deadline of a 3-D refinement, ms; taken between `replan_3d_ms` and `plan_3d_ms`.
     pub refine_3d_ms: u64,
     /// Least wall-clock time between the starts of two plans, ms.
     pub min_spacing_ms: u64,
@@ -98,8 +98,9 @@ pub struct TriggerConfig {
     /// is (`Restart`), not from the tasking's start (`Initial`). With an ownship state at
     /// hand it plans at once.
     pub first_plan_wait_ms: u64,
-    /// A plan made short of `Optimal` (a re-plan whose deadline cut the NLP) is planned
-    /// again once from itself with a plan-from-scratch budget (`Refine`).
+    /// A plan made short of `Optimal` (its deadline cut the NLP: mostly a short re-plan) is
+    /// planned again once, from the last plan the NLP made, with the `refine_*_ms` budget
+    /// (`Refine`).
     pub refine: bool,
 }
 
@@ -370,11 +371,14 @@ impl ServiceConfig {
         })
     }
 
-    /// Deadline of a refinement of a plan of `model` (`Refine`): at most the plan budget.
+    /// Deadline of a refinement of a plan of `model` (`Refine`): between the re-plan's and
+    /// the plan-from-scratch budget (a refinement is never shorter than the re-plan it
+    /// refines).
     pub fn refine_budget(&self, model: Model) -> Duration {
+        let b = &self.budget;
         Duration::from_millis(match model {
-            Model::TwoD => self.budget.refine_2d_ms.min(self.budget.plan_2d_ms),
-            Model::ThreeD => self.budget.refine_3d_ms.min(self.budget.plan_3d_ms),
+            Model::TwoD => b.refine_2d_ms.min(b.plan_2d_ms).max(b.replan_2d_ms),
+            Model::ThreeD => b.refine_3d_ms.min(b.plan_3d_ms).max(b.replan_3d_ms),
         })
     }
 

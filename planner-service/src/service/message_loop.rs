@@ -334,12 +334,12 @@ impl MessageLoop {
             .as_ref()
             .and_then(Tasking::model)
             .unwrap_or(Model::ThreeD);
-        if self.replans_in_flight(set) && triggers::refine_only(set) {
-            self.cfg.refine_budget(model)
-        } else if self.replans_in_flight(set) {
-            self.cfg.replan_budget(model)
-        } else {
+        if !self.replans_in_flight(set) {
             self.cfg.plan_budget(model)
+        } else if triggers::refine_only(set) {
+            self.cfg.refine_budget(model)
+        } else {
+            self.cfg.replan_budget(model)
         }
     }
 }

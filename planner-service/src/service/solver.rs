@@ -235,10 +235,10 @@ fn solve_loop(
     // Deadlines need `'static` parts: one log for the thread's lifetime.
     let cut_log: &'static CutLog = Box::leak(Box::new(CutLog::new()));
     // The last plan made, with its id: the plan in flight once the message thread took it.
-    let mut last: Option<(u64, FlyingPlan)> = None;
-    // The last plan the NLP made (`Optimal` or `Feasible`), with its id: a re-plan of a
-    // plan in flight that is the swarm's path starts from it instead.
-    let mut solved: Option<(u64, FlyingPlan)> = None;
+    let mut last: Option<Made> = None;
+    // The last plan the NLP made (`Optimal` or `Feasible`) since the last plan from
+    // scratch: a re-plan of a plan in flight that is the swarm's path starts from it.
+    let mut solved: Option<FlyingPlan> = None;
     let threads = settings.swarm.threads.max(settings.threads).max(1) as u32;
     for request in requests.iter() {
         let SolveRequest { problem, ticket } = request;
@@ -267,6 +267,10 @@ fn solve_loop(
             None => Deadline::after(clock, ticket.budget).earlier(handover_margin(ticket.budget)),
         }
         .with_cuts(cut_log);
+        if ticket.warm_from.is_none() {
+            // A plan from scratch: what the NLP made before is of another tasking or start.
+            solved = None;
+        }
         let flying = ticket
             .warm_from
             .and_then(|id| warm_start(id, last.as_ref(), solved.as_ref()));
@@ -315,10 +319,15 @@ fn solve_loop(
         if let Ok(o) = &outcome {
             let made =
                 FlyingPlan::new(&problem, o.trajectory.clone()).with_solution(o.solution.clone());
-            if matches!(o.quality, Quality::Optimal | Quality::Feasible) {
-                solved = Some((ticket.plan_id, made.clone()));
+            let nlp = matches!(o.quality, Quality::Optimal | Quality::Feasible);
+            if nlp {
+                solved = Some(made.clone());
             }
-            last = Some((ticket.plan_id, made));
+            last = Some(Made {
+                plan_id: ticket.plan_id,
+                plan: made,
+                nlp,
+            });
         }
         let result = SolveResult {
             problem,
@@ -336,20 +345,29 @@ fn solve_loop(
     }
 }
 
+/// The last plan the solve thread made.
+struct Made {
+    plan_id: u64,
+    plan: FlyingPlan,
+    /// Whether the NLP made it (`Optimal` or `Feasible`), or it is the swarm's path.
+    nlp: bool,
+}
+
 /// The plan a re-plan of plan `id` (the plan in flight) starts from: that plan, or if it
 /// is not the NLP's (the swarm's path of a re-plan its deadline cut: a start far from any
 /// optimum, and from which a 2-D re-plan of a 3000 s mission did not converge in 500 ms)
-/// the last plan the NLP made, cut at the new start as well, with the world it was made
-/// for (threats it did not know are new to it). `None` if plan `id` is not the last made.
+/// the last plan the NLP made since the last plan from scratch, cut at the new start as
+/// well, with the world it was made for (threats it did not know are new to it). `None`
+/// if plan `id` is not the last made.
 fn warm_start<'a>(
     id: u64,
-    last: Option<&'a (u64, FlyingPlan)>,
-    solved: Option<&'a (u64, FlyingPlan)>,
+    last: Option<&'a Made>,
+    solved: Option<&'a FlyingPlan>,
 ) -> Option<&'a FlyingPlan> {
-    let (made, flying) = last.filter(|(made, _)| *made == id)?;
+    let made = last.filter(|m| m.plan_id == id)?;
     match solved {
-        Some((at, nlp)) if at < made => Some(nlp),
-        _ => Some(flying),
+        Some(nlp) if !made.nlp => Some(nlp),
+        _ => Some(&made.plan),
     }
 }
 

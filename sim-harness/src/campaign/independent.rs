@@ -25,7 +25,8 @@ use wingman_planning::trajectory::Trajectory;
 use super::outcome::{COST_FLOOR, GAP_TOL, MissionOutcome, finite};
 use super::run::CampaignResults;
 
-/// Longest a mission's independent solve may take before it is stopped.
+/// Longest a mission's independent solve may take before it is stopped (its result is then
+/// the mission's `independent_error`).
 pub const TIME_LIMIT: Duration = Duration::from_secs(900);
 
 /// What the independent solver found for one mission's take-off.
@@ -95,6 +96,9 @@ pub fn solve(
 ) -> Result<IndependentNumbers, String> {
     let started = Instant::now();
     let mut child = Command::new("python3")
+        // One core: flights beside it (`--jobs`) keep theirs.
+        .env("OMP_NUM_THREADS", "1")
+        .env("OPENBLAS_NUM_THREADS", "1")
         .arg(script)
         .args(args)
         .arg(scenario)
@@ -115,24 +119,29 @@ pub fn solve(
     let stdout = read(Box::new(child.stdout.take().expect("piped")));
     let stderr = read(Box::new(child.stderr.take().expect("piped")));
     let status = loop {
-        match child.try_wait() {
+        let stop = match child.try_wait() {
             Ok(Some(status)) => break status,
             Ok(None) if started.elapsed() > TIME_LIMIT => {
-                let _ = child.kill();
-                let _ = child.wait();
-                return Err(format!("stopped after {} s", TIME_LIMIT.as_secs()));
+                format!("stopped after {} s", TIME_LIMIT.as_secs())
             }
-            Ok(None) => std::thread::sleep(Duration::from_millis(50)),
-            Err(e) => return Err(format!("waiting for the solver: {e}")),
-        }
+            Ok(None) => {
+                std::thread::sleep(Duration::from_millis(50));
+                continue;
+            }
+            Err(e) => format!("waiting for the solver: {e}"),
+        };
+        let _ = child.kill();
+        let _ = child.wait();
+        return Err(stop);
     };
     let (out, err) = (
         stdout.join().unwrap_or_default(),
         stderr.join().unwrap_or_default(),
     );
     let mut numbers = parse_output(&out).map_err(|e| {
-        let tail: String = err.lines().rev().take(3).collect::<Vec<_>>().join(" | ");
-        format!("{e} (exit {status}; stderr: {tail})")
+        let lines: Vec<&str> = err.lines().collect();
+        let tail = lines[lines.len().saturating_sub(3)..].join(" / ");
+        format!("{e} ({status}; stderr: {tail})")
     })?;
     numbers.compute_s = started.elapsed().as_secs_f64();
     Ok(numbers)
@@ -211,11 +220,12 @@ pub fn write_section(s: &mut String, r: &CampaignResults) {
         .count();
     let _ = writeln!(
         s,
-        "Every {every}th mission's take-off (`tools/yardstick/ipopt_multistart.py`: \
-         Hermite–Simpson in CasADi, IPOPT with exact Hessians, judged by the customer's \
-         judge; started from its own straight and bulged paths, the default plan and the \
-         yardstick's). Gaps as the yardstick's, against its best judged cost. It beat the \
-         yardstick by more than the tolerance on {beaten} of {} mission(s).\n",
+        "The take-off of every mission whose index is a multiple of {every} \
+         (`tools/yardstick/ipopt_multistart.py` by default: Hermite–Simpson in CasADi, IPOPT \
+         with exact Hessians, judged by the customer's judge; started from its own paths, \
+         the default plan and the yardstick's). Gaps as the yardstick's, against its best \
+         judged cost. It beat the yardstick by more than the tolerance on {beaten} of {} \
+         mission(s).\n",
         picked.len()
     );
     let _ = writeln!(
@@ -224,10 +234,23 @@ pub fn write_section(s: &mut String, r: &CampaignResults) {
     );
     let gap = |g: Option<f64>| g.map_or("-".into(), |g| format!("{:+.3} %", 100.0 * g));
     for o in picked {
-        let take_off = o.flight.as_ref().and_then(|f| f.take_off()).map(|t| t.cost);
+        let take_off = o
+            .flight
+            .as_ref()
+            .and_then(|f| f.take_off())
+            .map_or("-".into(), |t| format!("{:.6}", t.cost));
+        let yardstick = o
+            .yardstick
+            .as_ref()
+            .map_or("-".into(), |y| format!("{:.6}", y.cost));
         let Some(i) = &o.independent else {
             let why = o.independent_error.as_deref().unwrap_or("not run");
-            let _ = writeln!(s, "| {} | | | {why} | | | | | |", o.name);
+            let why = why.replace('|', "/");
+            let _ = writeln!(
+                s,
+                "| {} | {take_off} | {yardstick} | {why} | | | | | |",
+                o.name
+            );
             continue;
         };
         let start = Path::new(&i.start)
@@ -235,12 +258,8 @@ pub fn write_section(s: &mut String, r: &CampaignResults) {
             .map_or(i.start.clone(), |f| f.to_string_lossy().into_owned());
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.6} | {start} | {}/{} | {} | {} | {:.0} s |",
+            "| {} | {take_off} | {yardstick} | {:.6} | {start} | {}/{} | {} | {} | {:.0} s |",
             o.name,
-            take_off.map_or("-".into(), |c| format!("{c:.6}")),
-            o.yardstick
-                .as_ref()
-                .map_or("-".into(), |y| format!("{:.6}", y.cost)),
             i.cost,
             i.converged,
             i.starts,
@@ -260,7 +279,7 @@ mod tests {
     fn the_solvers_output_gives_its_best_judged_start() {
         let out = r#"{"scenario": "m", "starts": [
             {"status": "Solve_Succeeded", "judged_cost": 2.5, "start": "bulge 0"},
-            {"status": "Infeasible_Problem_Detected", "start": "bulge 0.25"},
+            {"status": "Infeasible_Problem_Detected", "nlp_objective": null, "start": "bulge 0.25"},
             {"status": "Solve_Succeeded", "judged_cost": 2.4, "start": "d/default_plan.json"}],
             "best": {"status": "Solve_Succeeded", "judged_cost": 2.4, "start": "d/default_plan.json"}}"#;
         let n = parse_output(out).unwrap();

@@ -46,7 +46,8 @@ fn join(
 ) -> anyhow::Result<CampaignResults> {
     anyhow::ensure!(
         a.spec == b.spec,
-        "{}: another campaign (its seed, count, filter or yardstick differ)",
+        "{}: another campaign (its seed, count, filter, yardstick, planner configuration or \
+         independent solver's settings differ)",
         file.display()
     );
     for s in &b.shards {

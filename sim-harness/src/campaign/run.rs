@@ -242,7 +242,11 @@ fn fly_mission(
         }
         Err(e) => outcome.error = Some(format!("{e:#}")),
     }
-    if opts.keep_all || outcome.outlying() {
+    // A mission where the independent solver beat the yardstick is kept too.
+    let beaten = outcome
+        .yardstick_vs_independent()
+        .is_some_and(|g| g > super::outcome::GAP_TOL);
+    if opts.keep_all || outcome.outlying() || beaten {
         outcome.kept = Some(format!("missions/{}", drawn.name));
     } else if let Err(e) = std::fs::remove_dir_all(&dir) {
         tracing::warn!("removing {}: {e}", dir.display());
@@ -332,23 +336,24 @@ fn independent(
     yardstick: Option<&Trajectory>,
 ) -> Result<IndependentNumbers, String> {
     let dir = file.parent().unwrap_or(Path::new("."));
-    let mut starts = Vec::new();
     let take_off = flight
         .plans
         .first()
-        .filter(|p| p.plan.trigger() == Some(wingman_interfaces::Trigger::Initial));
-    if let Some(p) = take_off {
-        let path = dir.join("default_plan.json");
-        PlanJson::of_plan(&p.plan, scenario.model)
-            .write(&path)
-            .map_err(|e| format!("{e:#}"))?;
-        starts.push(path);
-    }
-    if let Some(tr) = yardstick {
-        let path = dir.join("yardstick_plan.json");
-        PlanJson::of_trajectory(tr, scenario.model)
-            .write(&path)
-            .map_err(|e| format!("{e:#}"))?;
+        .filter(|p| p.plan.trigger() == Some(wingman_interfaces::Trigger::Initial))
+        .map(|p| {
+            (
+                "default_plan.json",
+                PlanJson::of_plan(&p.plan, scenario.model),
+            )
+        });
+    let yardstick = yardstick.map(|tr| {
+        let plan = PlanJson::of_trajectory(tr, scenario.model);
+        ("yardstick_plan.json", plan)
+    });
+    let mut starts = Vec::new();
+    for (name, plan) in take_off.into_iter().chain(yardstick) {
+        let path = dir.join(name);
+        plan.write(&path).map_err(|e| format!("{e:#}"))?;
         starts.push(path);
     }
     independent::solve(

@@ -139,7 +139,11 @@ impl MessageLoop {
             self.first = FirstPlan::NotDue;
             self.raise(trigger);
         }
-        let quiet = !self.lifecycle.is_planning() && self.lifecycle.pending().is_empty();
+        // A refinement waiting for the gate does not hold the time triggers back: they join
+        // it (and their plan takes their budget and their splice).
+        let pending = self.lifecycle.pending();
+        let quiet =
+            !self.lifecycle.is_planning() && (pending.is_empty() || triggers::refine_only(pending));
         if self.has_plan && quiet && self.batch.is_empty() {
             self.time_triggers(now, lead);
         }

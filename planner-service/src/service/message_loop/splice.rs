@@ -68,11 +68,16 @@ impl MessageLoop {
             _ => 0,
         };
         let own = self.world.ownship.as_ref();
-        let holding = own.is_some_and(OwnshipState::holding);
+        // A hold the current plan answers (reported before it started) is not this plan's.
+        let holding = own.is_some_and(|o| {
+            o.holding()
+                && plan.is_none_or(|p| triggers::holds_instead_of(o, p.plan_id, p.start_time_s))
+        });
         let from_ownship = triggers::splice_from_ownship(set, holding);
         let mission_over =
             plan.is_some_and(|p| p.valid_until_s >= p.final_time_s && t_c >= p.final_time_s);
-        if mission_over && set.only_of(&[Trigger::PopUp, Trigger::ScheduledReplan]) {
+        if mission_over && set.only_of(&[Trigger::PopUp, Trigger::ScheduledReplan, Trigger::Refine])
+        {
             info!(
                 trigger = trigger.name(),
                 "the plan ends before the commit time: no re-plan"
