@@ -13,6 +13,7 @@
 //! takes the logged cuts instead.
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -238,7 +239,7 @@ fn solve_loop(
     let mut last: Option<Made> = None;
     // The last plan the NLP made (`Optimal` or `Feasible`) since the last plan from
     // scratch: a re-plan of a plan in flight that is the swarm's path starts from it.
-    let mut solved: Option<FlyingPlan> = None;
+    let mut solved: Option<Arc<FlyingPlan>> = None;
     let threads = settings.swarm.threads.max(settings.threads).max(1) as u32;
     for request in requests.iter() {
         let SolveRequest { problem, ticket } = request;
@@ -317,11 +318,13 @@ fn solve_loop(
         }
         drop(_entered);
         if let Ok(o) = &outcome {
-            let made =
-                FlyingPlan::new(&problem, o.trajectory.clone()).with_solution(o.solution.clone());
+            // Shared by `last` and `solved`, not copied.
+            let made = Arc::new(
+                FlyingPlan::new(&problem, o.trajectory.clone()).with_solution(o.solution.clone()),
+            );
             let nlp = matches!(o.quality, Quality::Optimal | Quality::Feasible);
             if nlp {
-                solved = Some(made.clone());
+                solved = Some(Arc::clone(&made));
             }
             last = Some(Made {
                 plan_id: ticket.plan_id,
@@ -348,7 +351,7 @@ fn solve_loop(
 /// The last plan the solve thread made.
 struct Made {
     plan_id: u64,
-    plan: FlyingPlan,
+    plan: Arc<FlyingPlan>,
     /// Whether the NLP made it (`Optimal` or `Feasible`), or it is the swarm's path.
     nlp: bool,
 }
@@ -362,7 +365,7 @@ struct Made {
 fn warm_start<'a>(
     id: u64,
     last: Option<&'a Made>,
-    solved: Option<&'a FlyingPlan>,
+    solved: Option<&'a Arc<FlyingPlan>>,
 ) -> Option<&'a FlyingPlan> {
     let made = last.filter(|m| m.plan_id == id)?;
     match solved {
