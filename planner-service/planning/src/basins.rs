@@ -161,6 +161,13 @@ pub fn path_of_seed(problem: &Problem, seed: &Seed) -> Option<Trajectory> {
 /// Up to `count` starts: `first` (the swarm's best), then the cheapest seeds whose
 /// signature differs from every start taken so far, ranked by `cost`. The seeds' paths
 /// and costs are computed on `threads` threads (the same result for any number).
+///
+/// With a fixed final time two things differ. A seed that arrives at another time is no
+/// measure of its basin (a short one is cheap only because it is short), so the seeds that
+/// arrive within [`FITTED_TIME_TOL`] of it rank first. And where the spare length goes is
+/// a basin of its own that the threat sides do not tell apart (a wide loop far from every
+/// threat has no side), so a seed of a taken class is distinct too when its path is
+/// [`SLACK_SEPARATION_M`] from that start's.
 pub fn candidates(
     problem: &Problem,
     first: &Trajectory,
@@ -179,14 +186,28 @@ pub fn candidates(
     }
     let mut ranked = ranked_seeds(problem, seeds, threads, &cost);
     ranked.retain(|(c, _, _)| c.is_finite());
-    ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let late = |tr: &Trajectory| !arrives_on_time(problem, tr);
+    ranked.sort_by(|a, b| {
+        (late(&a.2).cmp(&late(&b.2)))
+            .then(a.0.total_cmp(&b.0))
+            .then(a.1.cmp(&b.1))
+    });
+    let apart = if problem.final_time.is_some() {
+        SLACK_SEPARATION_M
+    } else {
+        f64::INFINITY
+    };
     let mut rest = Vec::new();
     for (_, _, tr) in ranked {
         if out.len() >= count {
             break;
         }
         let sig = signature(problem, &xy(&tr));
-        if taken.iter().all(|t| !same_class(t, &sig)) {
+        let distinct = taken
+            .iter()
+            .zip(&out)
+            .all(|(t, o)| !same_class(t, &sig) || separation(o, &tr) > apart);
+        if distinct {
             taken.push(sig);
             out.push(tr);
         } else {
@@ -205,6 +226,22 @@ pub fn candidates(
         }
     }
     out
+}
+
+/// How far from a fixed final time (a fraction of the time the plan has) a seed may
+/// arrive to rank among the seeds that fit it.
+pub const FITTED_TIME_TOL: f64 = 0.02;
+
+/// Mean horizontal distance that makes two fixed-time paths of one class distinct starts.
+pub const SLACK_SEPARATION_M: f64 = 10_000.0;
+
+/// Whether `tr` ends within [`FITTED_TIME_TOL`] of the problem's fixed final time (always,
+/// without one).
+fn arrives_on_time(problem: &Problem, tr: &Trajectory) -> bool {
+    match (problem.final_time, tr.times.last()) {
+        (Some(tf), Some(end)) => (end - tf).abs() <= FITTED_TIME_TOL * (tf - problem.t0).max(1.0),
+        _ => true,
+    }
 }
 
 /// Every seed's path with its cost and index (seeds without a path left out), computed
@@ -288,5 +325,46 @@ mod tests {
                 assert_eq!(one, more, "{name}: {threads} threads differ from one");
             }
         }
+    }
+
+    /// With a fixed final time the starts after the swarm's best are seeds that arrive
+    /// within 2 % of it (the bundled mission has more such seeds, of distinct classes or
+    /// 10 km apart, than starts); on time means within 2 %, not 2.1 %.
+    #[test]
+    fn fixed_time_starts_arrive_on_time() {
+        let sc = bundled("2d-fixed-time-avoidable").unwrap().unwrap();
+        let problem = Problem::from_scenario(&sc).unwrap();
+        let tf = problem.final_time.unwrap();
+        let mut all = Vec::new();
+        seeds(&problem, &SeedSettings::default(), &mut all).unwrap();
+        let late = all
+            .iter()
+            .filter_map(|s| path_of_seed(&problem, s))
+            .filter(|tr| !arrives_on_time(&problem, tr))
+            .count();
+        assert!(late > 0, "some seeds arrive early or late");
+        let first = path_of_seed(&problem, &all[0]).expect("a path");
+        let cost = |tr: &Trajectory| crate::hybrid::trajectory_cost(&problem, tr);
+        let starts = candidates(&problem, &first, &all, 5, 1, cost);
+        assert_eq!(starts.len(), 5);
+        for s in &starts[1..] {
+            let end = *s.times.last().unwrap();
+            assert!(
+                (end - tf).abs() <= 0.02 * tf,
+                "a start ends at {end} s, not {tf} s"
+            );
+        }
+        let ending_at = |t: f64| {
+            let mut tr = first.clone();
+            let scale = (t - problem.t0) / (tr.times.last().unwrap() - problem.t0);
+            for time in tr.times.iter_mut() {
+                *time = problem.t0 + (*time - problem.t0) * scale;
+            }
+            tr
+        };
+        assert!(arrives_on_time(&problem, &ending_at(tf * 0.981)));
+        assert!(arrives_on_time(&problem, &ending_at(tf * 1.019)));
+        assert!(!arrives_on_time(&problem, &ending_at(tf * 0.979)));
+        assert!(!arrives_on_time(&problem, &ending_at(tf * 1.021)));
     }
 }

@@ -26,7 +26,10 @@
 //!   altitude profile in 3-D;
 //! - **fixed-time fits** (`fixed-time` only): for each left/straight/right pattern, the
 //!   common ratio whose path length is `V (t_f - t_0)`, found by bisection, so the seed
-//!   flown at `V` arrives on time;
+//!   flown at `V` arrives on time; and for each leg and side, the scan's cheapest
+//!   combination with all the spare length on that one leg (one wide loop through open
+//!   space is cheaper than the same length spread over every leg: a turn of radius `R`
+//!   costs `(V/R)^2`);
 //! - **random**: `random_seeds` curves with a ratio per leg drawn uniformly from
 //!   `[-random_bulge_max, random_bulge_max]` (and a random profile in 3-D);
 //! - **bisector scan** (listed first): for each leg, with the other legs straight, the

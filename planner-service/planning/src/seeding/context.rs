@@ -398,21 +398,33 @@ impl<'a> Context<'a> {
     /// The common bulge ratio whose path length matches `V (t_f - t_0)` for a sign
     /// pattern, by bisection on `[0, 2]` (`None` when even straight legs are too long).
     pub(super) fn fit_fixed_time(&self, signs: &[f64; MAX_PHASES], alt: Altitude) -> Option<f64> {
-        let tf = self.fixed_time?;
-        let end = self.end?;
-        let want = self.speed * (tf - self.t0);
-        let len = |b: f64| {
+        let common = |b: f64| {
             let mut bulges = [0.0; MAX_PHASES];
             for g in 0..self.legs {
                 bulges[g] = signs[g] * b;
             }
-            self.geometry(&bulges, alt, &end).map(|g| g.length)
+            bulges
         };
+        self.fit_length(common, 2.0, alt)
+    }
+
+    /// The ratio `b` in `[0, hi]` whose path `bulges(b)` has the length `V (t_f - t_0)`, by
+    /// bisection (the length grows with `b`); `None` when `bulges(0)` is already too long.
+    pub(super) fn fit_length(
+        &self,
+        bulges: impl Fn(f64) -> [f64; MAX_PHASES],
+        hi: f64,
+        alt: Altitude,
+    ) -> Option<f64> {
+        let tf = self.fixed_time?;
+        let end = self.end?;
+        let want = self.speed * (tf - self.t0);
+        let len = |b: f64| self.geometry(&bulges(b), alt, &end).map(|g| g.length);
         let l0 = len(0.0)?;
         if l0 >= want {
             return None;
         }
-        let (mut lo, mut hi) = (0.0, 2.0);
+        let (mut lo, mut hi) = (0.0, hi);
         if len(hi)? <= want {
             return Some(hi);
         }

@@ -38,17 +38,25 @@ pub(super) fn specs(ctx: &Context, settings: &SeedSettings, rng: &mut ChaCha8Rng
     } else {
         0
     };
-    let arc_budget = settings
-        .max_seeds
-        .saturating_sub(settings.random_seeds)
-        .saturating_sub(fit_budget)
-        .max(1);
+    // Fixed time: all the spare length on one leg, each leg on either side.
+    let one_leg_budget = if fit { 2 * legs * altitudes.len() } else { 0 };
 
     let mut specs: Vec<Spec> = Vec::new();
     scan_specs(ctx, settings, altitudes, &mut specs);
+    // The scan's combinations (up to 27 per profile) come out of the arcs' share when the
+    // fits follow them: otherwise the truncation to `max_seeds` cut the fits of 3-leg
+    // missions to 7 of 26. (Without fits, the arcs keep their share: those plans stay
+    // what they were.)
+    let scanned = if fit { specs.len() } else { 0 };
+    let arc_budget = settings
+        .max_seeds
+        .saturating_sub(settings.random_seeds)
+        .saturating_sub(fit_budget + one_leg_budget + scanned)
+        .max(1);
     arc_specs(settings, legs, altitudes, arc_budget, rng, &mut specs);
     if fit {
         fit_specs(ctx, n_signs, altitudes, &mut specs);
+        one_leg_specs(ctx, altitudes, &mut specs);
     }
     random_specs(settings, legs, altitudes, rng, &mut specs);
     specs.truncate(settings.max_seeds);
@@ -179,6 +187,38 @@ fn fit_specs(ctx: &Context, n_signs: usize, altitudes: &[Altitude], specs: &mut 
                     altitude: alt,
                     kind: SeedKind::FixedTimeFit,
                 });
+            }
+        }
+    }
+}
+
+/// Fixed-time slack on one leg: the scan's cheapest combination (its legs pass the threats
+/// where they are cheapest), with all the spare length taken by one bulge on one leg, left
+/// or right, up to 4 times the leg. A turn of radius `R` costs `u^2 = (V/R)^2`, so one wide
+/// loop through open space is cheaper than the same length spread as tighter bulges over
+/// every leg (the common-ratio fits), which is where the yardstick found the better plans
+/// of slack fixed-time missions.
+fn one_leg_specs(ctx: &Context, altitudes: &[Altitude], specs: &mut Vec<Spec>) {
+    let legs = ctx.legs;
+    for &alt in altitudes {
+        let base = specs
+            .iter()
+            .find(|s| s.kind == SeedKind::Scan && s.altitude == alt)
+            .map_or([0.0; MAX_PHASES], |s| s.bulges);
+        for g in 0..legs {
+            for side in [1.0, -1.0] {
+                let at = |b: f64| {
+                    let mut bulges = base;
+                    bulges[g] = side * b;
+                    bulges
+                };
+                if let Some(b) = ctx.fit_length(at, 4.0, alt) {
+                    specs.push(Spec {
+                        bulges: at(b),
+                        altitude: alt,
+                        kind: SeedKind::FixedTimeFit,
+                    });
+                }
             }
         }
     }

@@ -96,3 +96,51 @@ fn early_and_late_profiles_descend_first_or_last() {
     }
     assert!(checked[0] > 0 && checked[1] > 0, "{checked:?}");
 }
+
+/// The fixed-time slack on one leg: for each leg and side one seed that is the scan's
+/// cheapest combination but on that leg, with the length `V (t_f - t_0)` (within 0.1 %,
+/// the bisection's and the polyline's tolerance; the length is measured here on the
+/// seed's points).
+#[test]
+fn one_leg_fits_take_all_the_spare_length_on_one_leg() {
+    let sc = crate::scenario::bundled("2d-fixed-time-avoidable")
+        .unwrap()
+        .unwrap();
+    let problem = crate::problem::Problem::from_scenario(&sc).unwrap();
+    let mut out = Vec::new();
+    seeds(&problem, &SeedSettings::default(), &mut out).unwrap();
+    let want = sc.vehicle.speed_mps * (sc.final_point.as_ref().unwrap().time_s.unwrap() - 0.0);
+    let scan = out
+        .iter()
+        .find(|s| s.label.kind == SeedKind::Scan)
+        .expect("a scan seed")
+        .label
+        .bulges;
+    let legs = sc.targets.len() + 1;
+    let mut found = vec![[false; 2]; legs];
+    for seed in out
+        .iter()
+        .filter(|s| s.label.kind == SeedKind::FixedTimeFit)
+    {
+        let b = &seed.label.bulges;
+        let others_as_scan = |g: usize| (0..legs).all(|h| h == g || b[h] == scan[h]);
+        let Some(g) = (0..legs).find(|&g| b[g] != scan[g] && others_as_scan(g)) else {
+            continue;
+        };
+        let length: f64 = seed
+            .points
+            .windows(2)
+            .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+            .sum();
+        assert!(
+            (length - want).abs() < 1e-3 * want,
+            "{}: length {length} against {want}",
+            seed.label
+        );
+        found[g][usize::from(b[g] < 0.0)] = true;
+    }
+    assert!(
+        found.iter().all(|f| f[0] && f[1]),
+        "legs and sides found: {found:?}"
+    );
+}
