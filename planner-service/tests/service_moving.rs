@@ -114,15 +114,37 @@ fn a_moving_threat_is_tracked_and_its_t_r_schedules_a_replan() {
         .next_replan()
         .expect("the first plan passes the moving threat's region: it carries a t_r");
     assert_eq!(first.valid_until_s, t_r.min(first.final_time_s));
-    // The mission clock reaches t_r - budget (an ownship state carries it): the
-    // scheduled re-plan commits near t_r (the fixes may have moved t_r a little).
-    h.set_time(t_r - budget_s);
-    let mut own = OwnshipState::zeroed();
-    own.time_s = t_r - budget_s;
-    own.model = Model::ThreeD.to_wire();
-    own.plan_id = first.plan_id;
-    own.state = wingman_planning::plan_message::state_at(&first, t_r - budget_s).unwrap();
-    h.send_ownship(own);
+    // The mission clock nears t_r - budget in ownship reports 0.1 s apart: the planner
+    // sees time pass in those steps, so the scheduled re-plan fires one step early, at
+    // the first report at or after t_r - budget - 0.1 s, and commits before t_r (fired at
+    // the first report after t_r - budget, it would commit up to a step after t_r, and the
+    // tracker would hold in between).
+    let step = 0.1;
+    let own_at = |t: f64| {
+        let mut own = OwnshipState::zeroed();
+        own.time_s = t;
+        own.model = Model::ThreeD.to_wire();
+        own.plan_id = first.plan_id;
+        own.state = wingman_planning::plan_message::state_at(&first, t).unwrap();
+        own
+    };
+    for k in [3.0, 2.0] {
+        // The first report has no step yet (the lead is the budget); the second is one
+        // step short of the lead with it: a near miss.
+        let t = t_r - budget_s - k * step;
+        h.set_time(t);
+        h.send_ownship(own_at(t));
+        h.wake();
+        assert!(h.wait_processed(Duration::from_secs(60)));
+        assert_eq!(
+            h.last_status().plans_made,
+            1,
+            "no re-plan yet at t_r - budget - {k} steps"
+        );
+    }
+    let fired_at = t_r - budget_s - step;
+    h.set_time(fired_at);
+    h.send_ownship(own_at(fired_at));
     h.wake();
     assert!(
         h.wait_until(Duration::from_secs(180), |h| h
@@ -135,11 +157,12 @@ fn a_moving_threat_is_tracked_and_its_t_r_schedules_a_replan() {
     );
     let second = &h.plans[1];
     assert_eq!(second.trigger(), Some(Trigger::ScheduledReplan));
-    // Triggered at mission time t_r - budget (the ownship's header), committed one
-    // budget later: at t_r.
+    // Triggered at mission time t_r - budget - step (the ownship's header), committed one
+    // budget later: one step before t_r.
     assert!(
-        (second.start_time_s - t_r).abs() < 1e-6,
-        "the re-plan commits at (t_r - budget) + budget = {t_r}, got {}",
+        (second.start_time_s - (t_r - step)).abs() < 1e-6,
+        "the re-plan commits at (t_r - budget - step) + budget = {}, got {}",
+        t_r - step,
         second.start_time_s
     );
     eprintln!(

@@ -158,22 +158,35 @@ pub fn path_of_seed(problem: &Problem, seed: &Seed) -> Option<Trajectory> {
     (tr.phase_ends.len() == problem.phases() && tr.is_valid()).then_some(tr)
 }
 
+/// How the seeds are ranked as starts of a plan with a fixed final time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StartRanking {
+    /// The seeds that arrive on time first (the deployment default).
+    #[default]
+    OnTimeFirst,
+    /// The starts by cost alone (`count` with the swarm's best), then up to `count - 1`
+    /// more with the seeds that arrive on time first (the yardstick: no narrower than
+    /// either ranking).
+    Both,
+}
+
 /// Up to `count` starts: `first` (the swarm's best), then the cheapest seeds whose
 /// signature differs from every start taken so far, ranked by `cost`. The seeds' paths
 /// and costs are computed on `threads` threads (the same result for any number).
 ///
 /// With a fixed final time two things differ. A seed that arrives at another time is no
 /// measure of its basin (a short one is cheap only because it is short), so the seeds that
-/// arrive within [`FITTED_TIME_TOL`] of it rank first. And where the spare length goes is
-/// a basin of its own that the threat sides do not tell apart (a wide loop far from every
-/// threat has no side), so a seed of a taken class is distinct too when its path is
-/// [`SLACK_SEPARATION_M`] from that start's.
+/// arrive within [`FITTED_TIME_TOL`] of it rank first (`ranking`). And where the spare
+/// length goes is a basin of its own that the threat sides do not tell apart (a wide loop
+/// far from every threat has no side), so a seed of a taken class is distinct too when its
+/// path is [`SLACK_SEPARATION_M`] from that start's.
 pub fn candidates(
     problem: &Problem,
     first: &Trajectory,
     seeds: &[Seed],
     count: usize,
     threads: usize,
+    ranking: StartRanking,
     cost: impl Fn(&Trajectory) -> f64 + Sync,
 ) -> Vec<Trajectory> {
     let xy = |tr: &Trajectory| -> Vec<[f64; 3]> {
@@ -186,45 +199,56 @@ pub fn candidates(
     }
     let mut ranked = ranked_seeds(problem, seeds, threads, &cost);
     ranked.retain(|(c, _, _)| c.is_finite());
-    let late = |tr: &Trajectory| !arrives_on_time(problem, tr);
-    ranked.sort_by(|a, b| {
-        (late(&a.2).cmp(&late(&b.2)))
-            .then(a.0.total_cmp(&b.0))
-            .then(a.1.cmp(&b.1))
-    });
-    let apart = if problem.final_time.is_some() {
+    let by_cost = |a: &(f64, usize, Trajectory), b: &(f64, usize, Trajectory)| {
+        a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
+    };
+    let fixed_time = problem.final_time.is_some();
+    // Takes up to `more` seeds of `ranked` in order: a seed distinct from every
+    // start taken, then (fewer classes than slots, e.g. paths that must cross threats,
+    // where only the crossing point differs) the others geometrically apart from every
+    // start taken (mean horizontal distance over the path's fraction).
+    let mut pick = |ranked: &[(f64, usize, Trajectory)], more: usize, apart: f64| {
+        let upto = out.len() + more;
+        let mut rest = Vec::new();
+        for (_, _, tr) in ranked {
+            if out.len() >= upto {
+                break;
+            }
+            let sig = signature(problem, &xy(tr));
+            let distinct = taken
+                .iter()
+                .zip(&out)
+                .all(|(t, o)| !same_class(t, &sig) || separation(o, tr) > apart);
+            if distinct {
+                taken.push(sig);
+                out.push(tr.clone());
+            } else {
+                rest.push((sig, tr));
+            }
+        }
+        for (sig, tr) in rest {
+            if out.len() >= upto {
+                break;
+            }
+            if out.iter().all(|o| separation(o, tr) > MIN_SEPARATION_M) {
+                taken.push(sig);
+                out.push(tr.clone());
+            }
+        }
+    };
+    if fixed_time && ranking == StartRanking::Both {
+        // As if the time did not matter: by cost, of distinct classes.
+        ranked.sort_by(by_cost);
+        pick(&ranked, count - 1, f64::INFINITY);
+    }
+    let apart = if fixed_time {
         SLACK_SEPARATION_M
     } else {
         f64::INFINITY
     };
-    let mut rest = Vec::new();
-    for (_, _, tr) in ranked {
-        if out.len() >= count {
-            break;
-        }
-        let sig = signature(problem, &xy(&tr));
-        let distinct = taken
-            .iter()
-            .zip(&out)
-            .all(|(t, o)| !same_class(t, &sig) || separation(o, &tr) > apart);
-        if distinct {
-            taken.push(sig);
-            out.push(tr);
-        } else {
-            rest.push(tr);
-        }
-    }
-    // Fewer classes than slots (e.g. paths that must cross threats, where only the
-    // crossing point differs): fill with the cheapest seeds that are geometrically apart
-    // from every start taken (mean horizontal distance over the path's fraction).
-    for tr in rest {
-        if out.len() >= count {
-            break;
-        }
-        if out.iter().all(|o| separation(o, &tr) > MIN_SEPARATION_M) {
-            out.push(tr);
-        }
-    }
+    let late = |tr: &Trajectory| !arrives_on_time(problem, tr);
+    ranked.sort_by(|a, b| late(&a.2).cmp(&late(&b.2)).then(by_cost(a, b)));
+    pick(&ranked, count - 1, apart);
     out
 }
 
@@ -318,10 +342,26 @@ mod tests {
             assert!(all.len() > 8, "{name}: {} seeds", all.len());
             let first = path_of_seed(&problem, &all[0]).expect("a path");
             let cost = |tr: &Trajectory| crate::hybrid::trajectory_cost(&problem, tr);
-            let one = candidates(&problem, &first, &all, 5, 1, cost);
+            let one = candidates(
+                &problem,
+                &first,
+                &all,
+                5,
+                1,
+                StartRanking::OnTimeFirst,
+                cost,
+            );
             assert!(one.len() >= 3, "{name}: {} starts", one.len());
             for threads in [2, 3] {
-                let more = candidates(&problem, &first, &all, 5, threads, cost);
+                let more = candidates(
+                    &problem,
+                    &first,
+                    &all,
+                    5,
+                    threads,
+                    StartRanking::OnTimeFirst,
+                    cost,
+                );
                 assert_eq!(one, more, "{name}: {threads} threads differ from one");
             }
         }
@@ -345,7 +385,15 @@ mod tests {
         assert!(late > 0, "some seeds arrive early or late");
         let first = path_of_seed(&problem, &all[0]).expect("a path");
         let cost = |tr: &Trajectory| crate::hybrid::trajectory_cost(&problem, tr);
-        let starts = candidates(&problem, &first, &all, 5, 1, cost);
+        let starts = candidates(
+            &problem,
+            &first,
+            &all,
+            5,
+            1,
+            StartRanking::OnTimeFirst,
+            cost,
+        );
         assert_eq!(starts.len(), 5);
         for s in &starts[1..] {
             let end = *s.times.last().unwrap();
@@ -366,5 +414,30 @@ mod tests {
         assert!(arrives_on_time(&problem, &ending_at(tf * 1.019)));
         assert!(!arrives_on_time(&problem, &ending_at(tf * 0.979)));
         assert!(!arrives_on_time(&problem, &ending_at(tf * 1.021)));
+    }
+
+    /// The yardstick's ranking takes the starts by cost alone first (on the bundled
+    /// mission some of them arrive early: cheap because short), then more with the seeds
+    /// on time first, beyond `count`.
+    #[test]
+    fn both_rankings_take_the_cheap_early_seeds_and_the_on_time_ones() {
+        let sc = bundled("2d-fixed-time-avoidable").unwrap().unwrap();
+        let problem = Problem::from_scenario(&sc).unwrap();
+        let mut all = Vec::new();
+        seeds(&problem, &SeedSettings::default(), &mut all).unwrap();
+        let first = path_of_seed(&problem, &all[0]).expect("a path");
+        let cost = |tr: &Trajectory| crate::hybrid::trajectory_cost(&problem, tr);
+        let both = candidates(&problem, &first, &all, 5, 1, StartRanking::Both, cost);
+        assert!(both.len() > 5, "{} starts", both.len());
+        assert!(both.len() <= 9, "{} starts", both.len());
+        let early = both[1..5]
+            .iter()
+            .filter(|s| !arrives_on_time(&problem, s))
+            .count();
+        assert!(early > 0, "the cheapest seeds by cost alone arrive early");
+        assert!(
+            both[5..].iter().all(|s| arrives_on_time(&problem, s)),
+            "the rest arrive on time"
+        );
     }
 }

@@ -240,6 +240,8 @@ pub struct World {
     last_seen: [Option<Duration>; Input::COUNT],
     /// Per input, the last accepted header of each of up to [`SENDERS_PER_INPUT`] senders.
     last_header: [[Option<Header>; SENDERS_PER_INPUT]; Input::COUNT],
+    /// Mission time between the last two ownship reports, ns (0 before two).
+    ownship_step_ns: i64,
 }
 
 impl Default for World {
@@ -258,6 +260,7 @@ impl Default for World {
             gaps: SequenceGaps::default(),
             last_seen: [None; Input::COUNT],
             last_header: [[None; SENDERS_PER_INPUT]; Input::COUNT],
+            ownship_step_ns: 0,
         }
     }
 }
@@ -324,7 +327,19 @@ impl World {
     }
 
     pub fn apply_ownship(&mut self, s: &OwnshipState) {
+        if let Some(last) = &self.ownship {
+            let step = s.header.mission_time_ns - last.header.mission_time_ns;
+            if step > 0 {
+                self.ownship_step_ns = step;
+            }
+        }
         self.ownship = Some(*s);
+    }
+
+    /// The mission time between the last two ownship reports, s (0 before two): how late
+    /// the planner may see a moment pass, so time triggers fire this much earlier.
+    pub fn ownship_step_s(&self) -> f64 {
+        self.ownship_step_ns as f64 * 1e-9
     }
 
     /// Takes a threat report: the latest report per `threat_id` wins. A threat that

@@ -7,7 +7,8 @@
 //! Wider means: every seed family with more bulge ratios (0.15 to 1.2 of a leg), eight
 //! times the random seeds, the altitude profiles that descend or climb early and late
 //! beside the direct and the high ones, a swarm of 64 particles in 8 groups for 300
-//! iterations, 24 NLP starts from distinct basins, 6 finalists within 50 % of the best, two
+//! iterations, 24 NLP starts from distinct basins (with a fixed final time 24 by cost and
+//! up to 23 more with the seeds that arrive on time first), 6 finalists within 50 % of the best, two
 //! refinement rounds.
 
 use std::time::Duration;
@@ -15,6 +16,7 @@ use std::time::Duration;
 use wingman_interfaces::Quality;
 
 use super::{PlanError, PlanOutcome, Planner, PlannerSettings};
+use crate::basins::StartRanking;
 use crate::clock::{Clock, Deadline};
 use crate::cuts::CutLog;
 use crate::problem::Problem;
@@ -74,6 +76,7 @@ impl PlannerSettings {
             .with_max_seeds(512)
             .with_scan_minima(5);
         s.starts = 24;
+        s.start_ranking = StartRanking::Both;
         s.finalists = 6;
         s.finalist_gap_tol = 0.5;
         s.refine_rounds = 2;

@@ -196,6 +196,7 @@ impl Planner {
             self.swarm.seeds(),
             settings.starts.max(1),
             settings.threads,
+            settings.start_ranking,
             |tr| trajectory_cost(problem, tr),
         )
     }

@@ -1,6 +1,7 @@
 //! The planner's settings: each stage's, with their deployment defaults (why each default
 //! is what it is: `docs/decisions/`), and their check before a plan starts.
 
+use crate::basins::StartRanking;
 use crate::collocation::{ExportSettings, NlpSettings, RefineSettings, TranscriptionSettings};
 use crate::swarm::{self, SwarmSettings};
 
@@ -48,6 +49,8 @@ pub struct PlannerSettings {
     /// NLP starts from distinct basins: the swarm's best and the best seeds that pass some
     /// threat on another side (see `basins`).
     pub starts: usize,
+    /// How a fixed-time plan's seeds are ranked as starts (see `basins::candidates`).
+    pub start_ranking: StartRanking,
     /// Threads solving the starts' NLPs side by side.
     pub threads: usize,
     /// The coarser mesh on which all starts are first ranked (2-D).
@@ -120,7 +123,8 @@ impl Default for PlannerSettings {
             refine_rounds: 1, // more moved no cost, took 20-30 % of the plan (0011)
             export: ExportSettings::default(),
             swarm_share: 0.3,
-            starts: 5,  // six's worst cost, a 16 % shorter ranking; four lose basins (0021)
+            starts: 5, // six's worst cost, a 16 % shorter ranking; four lose basins (0021)
+            start_ranking: StartRanking::OnTimeFirst,
             threads: 2, // the NLP tasks on two threads (0023)
             // Coarser meshes lose basins; four points only in 3-D (0012).
             ranking_mesh: MeshSettings {

@@ -186,7 +186,15 @@ fn seed_starts(
     })
     .map_err(SwarmError::from)?;
     let cost = |tr: &Trajectory| trajectory_cost(problem, tr);
-    let mut starts = basins::candidates(problem, guess, &seeds, 1 + count, settings.threads, cost);
+    let mut starts = basins::candidates(
+        problem,
+        guess,
+        &seeds,
+        1 + count,
+        settings.threads,
+        settings.start_ranking,
+        cost,
+    );
     // The first is `guess` itself.
     starts.remove(0);
     Ok(starts)

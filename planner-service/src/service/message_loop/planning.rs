@@ -13,6 +13,10 @@ use crate::service::solver::{SolveRequest, Ticket};
 use crate::service::triggers::{self, DeviationBounds, PlanWindow, PopupAssessment, TriggerSet};
 use crate::service::world::ThreatSlot;
 
+/// The longest ownship step the time triggers' lead takes in, s (a stalled ownship feed
+/// must not make every plan expire at once).
+const MAX_TIME_STEP_S: f64 = 1.0;
+
 /// Triggers raised in one pass, before `evaluate` folds them into the lifecycle.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct Batch {
@@ -129,8 +133,12 @@ impl MessageLoop {
     /// Returns whether anything changed.
     pub(super) fn evaluate(&mut self) -> bool {
         let now = self.world.now_s();
-        // The time triggers re-plan the plan in flight: so far ahead they fire.
-        let lead = self.budget(TriggerSet::EMPTY).as_secs_f64();
+        // The time triggers re-plan the plan in flight: so far ahead they fire, and one
+        // ownship report earlier (the planner sees time pass in those steps: fired at the
+        // first report within one budget of `t_r`, a plan committed up to a step after
+        // it, and the tracker held in between).
+        let lead = self.budget(TriggerSet::EMPTY).as_secs_f64()
+            + self.world.ownship_step_s().min(MAX_TIME_STEP_S);
         if self.first_plan_due()
             && !self.waiting_for_ownship()
             && let Some(t) = &self.world.tasking
