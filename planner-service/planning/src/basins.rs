@@ -4,7 +4,7 @@
 //! best seeds that pass some threat on the *other* side are the others (the reference
 //! optimum itself was found by a multistart over such left/right arc combinations).
 
-use wingman_interfaces::Model;
+use wingman_interfaces::{Model, Objective};
 
 use crate::dynamics::{ReducedPath, Spatial, lift_reduced_path, wrap_angle};
 use crate::problem::{Problem, Threats};
@@ -164,15 +164,17 @@ pub enum StartRanking {
     /// The seeds that arrive on time first (the deployment default).
     #[default]
     OnTimeFirst,
-    /// The starts by cost alone (`count` with the swarm's best), then up to `count - 1`
-    /// more with the seeds that arrive on time first (the yardstick: no narrower than
-    /// either ranking).
+    /// The starts by cost alone, as if the time did not matter (`count` with the swarm's
+    /// best, of distinct classes), then up to `count - 1` more with the seeds that arrive
+    /// on time first (the yardstick: the picks of both rankings, but for on-time seeds too
+    /// near a start already taken).
     Both,
 }
 
-/// Up to `count` starts: `first` (the swarm's best), then the cheapest seeds whose
-/// signature differs from every start taken so far, ranked by `cost`. The seeds' paths
-/// and costs are computed on `threads` threads (the same result for any number).
+/// Up to `count` starts (`2 count - 1` with [`StartRanking::Both`]): `first` (the swarm's
+/// best), then the cheapest seeds whose signature differs from every start taken so far,
+/// ranked by `cost`. The seeds' paths and costs are computed on `threads` threads (the
+/// same result for any number).
 ///
 /// With a fixed final time two things differ. A seed that arrives at another time is no
 /// measure of its basin (a short one is cheap only because it is short), so the seeds that
@@ -192,75 +194,82 @@ pub fn candidates(
     let xy = |tr: &Trajectory| -> Vec<[f64; 3]> {
         tr.states.iter().map(|s| problem.position(s)).collect()
     };
-    let mut taken = vec![signature(problem, &xy(first))];
-    let mut out = vec![first.clone()];
+    let mut taken = vec![(signature(problem, &xy(first)), first.clone())];
     if count <= 1 {
-        return out;
+        return vec![first.clone()];
     }
-    let mut ranked = ranked_seeds(problem, seeds, threads, &cost);
-    ranked.retain(|(c, _, _)| c.is_finite());
-    let by_cost = |a: &(f64, usize, Trajectory), b: &(f64, usize, Trajectory)| {
+    let fixed_time = problem.objective == Objective::FixedTime;
+    // Each seed's path with its cost, index, and whether it arrives off time.
+    let mut ranked: Vec<(f64, usize, bool, Trajectory)> =
+        ranked_seeds(problem, seeds, threads, &cost)
+            .into_iter()
+            .filter(|(c, _, _)| c.is_finite())
+            .map(|(c, i, tr)| (c, i, fixed_time && !arrives_on_time(problem, &tr), tr))
+            .collect();
+    let by_cost = |a: &(f64, usize, bool, Trajectory), b: &(f64, usize, bool, Trajectory)| {
         a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
     };
-    let fixed_time = problem.final_time.is_some();
-    // Takes up to `more` seeds of `ranked` in order: a seed distinct from every
-    // start taken, then (fewer classes than slots, e.g. paths that must cross threats,
-    // where only the crossing point differs) the others geometrically apart from every
-    // start taken (mean horizontal distance over the path's fraction).
-    let mut pick = |ranked: &[(f64, usize, Trajectory)], more: usize, apart: f64| {
-        let upto = out.len() + more;
-        let mut rest = Vec::new();
-        for (_, _, tr) in ranked {
-            if out.len() >= upto {
-                break;
-            }
-            let sig = signature(problem, &xy(tr));
-            let distinct = taken
-                .iter()
-                .zip(&out)
-                .all(|(t, o)| !same_class(t, &sig) || separation(o, tr) > apart);
-            if distinct {
-                taken.push(sig);
-                out.push(tr.clone());
-            } else {
-                rest.push((sig, tr));
-            }
-        }
-        for (sig, tr) in rest {
-            if out.len() >= upto {
-                break;
-            }
-            if out.iter().all(|o| separation(o, tr) > MIN_SEPARATION_M) {
-                taken.push(sig);
-                out.push(tr.clone());
-            }
-        }
-    };
     if fixed_time && ranking == StartRanking::Both {
-        // As if the time did not matter: by cost, of distinct classes.
         ranked.sort_by(by_cost);
-        pick(&ranked, count - 1, f64::INFINITY);
+        pick(problem, &ranked, count - 1, None, &mut taken);
     }
-    let apart = if fixed_time {
-        SLACK_SEPARATION_M
-    } else {
-        f64::INFINITY
-    };
-    let late = |tr: &Trajectory| !arrives_on_time(problem, tr);
-    ranked.sort_by(|a, b| late(&a.2).cmp(&late(&b.2)).then(by_cost(a, b)));
-    pick(&ranked, count - 1, apart);
-    out
+    ranked.sort_by(|a, b| a.2.cmp(&b.2).then(by_cost(a, b)));
+    let apart = fixed_time.then_some(SLACK_SEPARATION_M);
+    pick(problem, &ranked, count - 1, apart, &mut taken);
+    taken.into_iter().map(|(_, tr)| tr).collect()
 }
 
-/// How far from a fixed final time (a fraction of the time the plan has) a seed may
-/// arrive to rank among the seeds that fit it.
+/// Takes up to `more` seeds of `ranked` in order into `taken`: a seed whose class differs
+/// from every start taken (or, with `apart`, whose path is that far from the start of its
+/// class), then, with fewer classes than slots (e.g. paths that must cross threats, where
+/// only the crossing point differs), the others geometrically apart from every start
+/// taken (mean horizontal distance over the path's fraction).
+fn pick(
+    problem: &Problem,
+    ranked: &[(f64, usize, bool, Trajectory)],
+    more: usize,
+    apart: Option<f64>,
+    taken: &mut Vec<(Signature, Trajectory)>,
+) {
+    let upto = taken.len() + more;
+    let mut rest = Vec::new();
+    for (_, _, _, tr) in ranked {
+        if taken.len() >= upto {
+            break;
+        }
+        let points: Vec<[f64; 3]> = tr.states.iter().map(|s| problem.position(s)).collect();
+        let sig = signature(problem, &points);
+        let distinct = taken
+            .iter()
+            .all(|(t, o)| !same_class(t, &sig) || apart.is_some_and(|far| separation(o, tr) > far));
+        if distinct {
+            taken.push((sig, tr.clone()));
+        } else {
+            rest.push((sig, tr));
+        }
+    }
+    for (sig, tr) in rest {
+        if taken.len() >= upto {
+            break;
+        }
+        if taken
+            .iter()
+            .all(|(_, o)| separation(o, tr) > MIN_SEPARATION_M)
+        {
+            taken.push((sig, tr.clone()));
+        }
+    }
+}
+
+/// How far from a fixed final time, as a fraction of the time the plan has (`t_f - t_0`),
+/// a seed may arrive to rank among the seeds that fit it.
 pub const FITTED_TIME_TOL: f64 = 0.02;
 
 /// Mean horizontal distance that makes two fixed-time paths of one class distinct starts.
 pub const SLACK_SEPARATION_M: f64 = 10_000.0;
 
-/// Whether `tr` ends within [`FITTED_TIME_TOL`] of the problem's fixed final time (always,
-/// without one).
+/// Whether `tr` ends within [`FITTED_TIME_TOL`] of the time the problem has, `t_f - t_0`,
+/// from its fixed final time (always, without one).
 fn arrives_on_time(problem: &Problem, tr: &Trajectory) -> bool {
     match (problem.final_time, tr.times.last()) {
         (Some(tf), Some(end)) => (end - tf).abs() <= FITTED_TIME_TOL * (tf - problem.t0).max(1.0),
@@ -375,6 +384,7 @@ mod tests {
         let sc = bundled("2d-fixed-time-avoidable").unwrap().unwrap();
         let problem = Problem::from_scenario(&sc).unwrap();
         let tf = problem.final_time.unwrap();
+        let t = tf - problem.t0;
         let mut all = Vec::new();
         seeds(&problem, &SeedSettings::default(), &mut all).unwrap();
         let late = all
@@ -398,22 +408,22 @@ mod tests {
         for s in &starts[1..] {
             let end = *s.times.last().unwrap();
             assert!(
-                (end - tf).abs() <= 0.02 * tf,
+                (end - tf).abs() <= 0.02 * t,
                 "a start ends at {end} s, not {tf} s"
             );
         }
-        let ending_at = |t: f64| {
+        let ending_at = |end: f64| {
             let mut tr = first.clone();
-            let scale = (t - problem.t0) / (tr.times.last().unwrap() - problem.t0);
+            let scale = (end - problem.t0) / (tr.times.last().unwrap() - problem.t0);
             for time in tr.times.iter_mut() {
                 *time = problem.t0 + (*time - problem.t0) * scale;
             }
             tr
         };
-        assert!(arrives_on_time(&problem, &ending_at(tf * 0.981)));
-        assert!(arrives_on_time(&problem, &ending_at(tf * 1.019)));
-        assert!(!arrives_on_time(&problem, &ending_at(tf * 0.979)));
-        assert!(!arrives_on_time(&problem, &ending_at(tf * 1.021)));
+        assert!(arrives_on_time(&problem, &ending_at(tf - 0.019 * t)));
+        assert!(arrives_on_time(&problem, &ending_at(tf + 0.019 * t)));
+        assert!(!arrives_on_time(&problem, &ending_at(tf - 0.021 * t)));
+        assert!(!arrives_on_time(&problem, &ending_at(tf + 0.021 * t)));
     }
 
     /// The yardstick's ranking takes the starts by cost alone first (on the bundled

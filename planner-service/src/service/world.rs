@@ -240,7 +240,7 @@ pub struct World {
     last_seen: [Option<Duration>; Input::COUNT],
     /// Per input, the last accepted header of each of up to [`SENDERS_PER_INPUT`] senders.
     last_header: [[Option<Header>; SENDERS_PER_INPUT]; Input::COUNT],
-    /// Mission time between the last two ownship reports, ns (0 before two).
+    /// Mission time between the last two ownship reports of one sender, ns (0 before two).
     ownship_step_ns: i64,
 }
 
@@ -290,8 +290,9 @@ impl World {
         let same = senders
             .iter()
             .position(|h| h.is_some_and(|h| h.sender_id == header.sender_id));
-        if let Some(previous) = same.and_then(|s| senders[s]) {
-            header.check_follows(&previous)?;
+        let previous = same.and_then(|s| senders[s]);
+        if let Some(previous) = &previous {
+            header.check_follows(previous)?;
         }
         // A sender beyond the first few on one input takes the first slot.
         let slot = same
@@ -300,6 +301,16 @@ impl World {
         senders[slot] = Some(*header);
         self.last_seen[k] = Some(wall);
         self.now_ns = self.now_ns.max(header.mission_time_ns);
+        if input == Input::Ownship
+            && let Some(previous) = previous
+        {
+            let step = header
+                .mission_time_ns
+                .saturating_sub(previous.mission_time_ns);
+            if step > 0 {
+                self.ownship_step_ns = step;
+            }
+        }
         self.max_sequence = self.max_sequence.max(header.sequence);
         Ok(())
     }
@@ -327,17 +338,12 @@ impl World {
     }
 
     pub fn apply_ownship(&mut self, s: &OwnshipState) {
-        if let Some(last) = &self.ownship {
-            let step = s.header.mission_time_ns - last.header.mission_time_ns;
-            if step > 0 {
-                self.ownship_step_ns = step;
-            }
-        }
         self.ownship = Some(*s);
     }
 
-    /// The mission time between the last two ownship reports, s (0 before two): how late
-    /// the planner may see a moment pass, so time triggers fire this much earlier.
+    /// The mission time between the last two ownship reports of one sender, s (0 before
+    /// two): how late the planner may see a moment pass, so time triggers fire this much
+    /// earlier.
     pub fn ownship_step_s(&self) -> f64 {
         self.ownship_step_ns as f64 * 1e-9
     }
@@ -646,5 +652,65 @@ mod tests {
         assert_eq!(w.max_sequence, 6);
         // Another input keeps its own record.
         assert!(w.accept_header(Input::Ownship, &h(2, 3), wall).is_ok());
+    }
+
+    /// The ownship step is one sender's: a second sender 0.5 s behind, in between, does
+    /// not make it 0.6 s; other inputs and refused headers do not move it.
+    #[test]
+    fn the_ownship_step_is_taken_per_sender() {
+        let mut w = World::default();
+        let wall = Duration::ZERO;
+        let h =
+            |sender: u32, sequence: u64, t_ms: i64| Header::new(sender, sequence, t_ms * 1_000_000);
+        assert!(
+            w.accept_header(Input::Ownship, &h(2, 1, 10_000), wall)
+                .is_ok()
+        );
+        assert_eq!(w.ownship_step_s(), 0.0, "one report: no step yet");
+        assert!(
+            w.accept_header(Input::Ownship, &h(7, 1, 9_500), wall)
+                .is_ok()
+        );
+        assert!(
+            w.accept_header(Input::Ownship, &h(2, 2, 10_100), wall)
+                .is_ok()
+        );
+        assert!(
+            (w.ownship_step_s() - 0.1).abs() < 1e-12,
+            "{}",
+            w.ownship_step_s()
+        );
+        assert!(
+            w.accept_header(Input::Ownship, &h(7, 2, 9_600), wall)
+                .is_ok()
+        );
+        assert!(
+            (w.ownship_step_s() - 0.1).abs() < 1e-12,
+            "{}",
+            w.ownship_step_s()
+        );
+        assert!(
+            w.accept_header(Input::LeadState, &h(2, 3, 10_150), wall)
+                .is_ok()
+        );
+        // A repeated sequence is refused: its 0.3 s step does not count.
+        assert!(
+            w.accept_header(Input::Ownship, &h(2, 2, 10_400), wall)
+                .is_err()
+        );
+        assert!(
+            (w.ownship_step_s() - 0.1).abs() < 1e-12,
+            "{}",
+            w.ownship_step_s()
+        );
+        assert!(
+            w.accept_header(Input::Ownship, &h(2, 4, 10_300), wall)
+                .is_ok()
+        );
+        assert!(
+            (w.ownship_step_s() - 0.2).abs() < 1e-12,
+            "{}",
+            w.ownship_step_s()
+        );
     }
 }

@@ -16,7 +16,7 @@ use super::{
     Gathered, NlpReport, PlanError, PlanOutcome, PlanPath, Planner, PlannerSettings, StageTimes,
     gather, ranking_meshes, reference_export, schedule, trajectory_cost,
 };
-use crate::basins;
+use crate::basins::{self, StartRanking};
 use crate::clock::Deadline;
 use crate::collocation::transcription::nearest_turn;
 use crate::collocation::{PrimalDual, Transcription, export};
@@ -192,7 +192,9 @@ fn seed_starts(
         &seeds,
         1 + count,
         settings.threads,
-        settings.start_ranking,
+        // A warm re-plan's few seed starts, ranked as a plan's (the yardstick's wider
+        // ranking would double them).
+        StartRanking::OnTimeFirst,
         cost,
     );
     // The first is `guess` itself.

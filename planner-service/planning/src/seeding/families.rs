@@ -192,9 +192,11 @@ fn fit_specs(ctx: &Context, n_signs: usize, altitudes: &[Altitude], specs: &mut 
     }
 }
 
-/// Fixed-time slack on one leg: the scan's cheapest combination (its legs pass the threats
-/// where they are cheapest), with all the spare length taken by one bulge on one leg, left
-/// or right, up to 4 times the leg. A turn of radius `R` costs `u^2 = (V/R)^2`, so one wide
+/// Fixed-time slack on one leg: the scan's cheapest combination on the other legs (they
+/// pass the threats where it is cheapest), and on that leg, left or right, the one bulge
+/// (bisected from straight, up to 4 times the leg) that takes all the spare length. (With
+/// the other legs straight it repeats a common-ratio fit; where 4 legs' worth is still too
+/// short it arrives early, ranked as such.) A turn of radius `R` costs `u^2 = (V/R)^2`, so one wide
 /// loop through open space is cheaper than the same length spread as tighter bulges over
 /// every leg (the common-ratio fits), which is where the yardstick found the better plans
 /// of slack fixed-time missions.
