@@ -659,58 +659,26 @@ mod tests {
     #[test]
     fn the_ownship_step_is_taken_per_sender() {
         let mut w = World::default();
-        let wall = Duration::ZERO;
-        let h =
-            |sender: u32, sequence: u64, t_ms: i64| Header::new(sender, sequence, t_ms * 1_000_000);
-        assert!(
-            w.accept_header(Input::Ownship, &h(2, 1, 10_000), wall)
-                .is_ok()
-        );
-        assert_eq!(w.ownship_step_s(), 0.0, "one report: no step yet");
-        assert!(
-            w.accept_header(Input::Ownship, &h(7, 1, 9_500), wall)
-                .is_ok()
-        );
-        assert!(
-            w.accept_header(Input::Ownship, &h(2, 2, 10_100), wall)
-                .is_ok()
-        );
-        assert!(
-            (w.ownship_step_s() - 0.1).abs() < 1e-12,
-            "{}",
-            w.ownship_step_s()
-        );
-        assert!(
-            w.accept_header(Input::Ownship, &h(7, 2, 9_600), wall)
-                .is_ok()
-        );
-        assert!(
-            (w.ownship_step_s() - 0.1).abs() < 1e-12,
-            "{}",
-            w.ownship_step_s()
-        );
-        assert!(
-            w.accept_header(Input::LeadState, &h(2, 3, 10_150), wall)
-                .is_ok()
-        );
-        // A repeated sequence is refused: its 0.3 s step does not count.
-        assert!(
-            w.accept_header(Input::Ownship, &h(2, 2, 10_400), wall)
-                .is_err()
-        );
-        assert!(
-            (w.ownship_step_s() - 0.1).abs() < 1e-12,
-            "{}",
-            w.ownship_step_s()
-        );
-        assert!(
-            w.accept_header(Input::Ownship, &h(2, 4, 10_300), wall)
-                .is_ok()
-        );
-        assert!(
-            (w.ownship_step_s() - 0.2).abs() < 1e-12,
-            "{}",
-            w.ownship_step_s()
-        );
+        // (input, sender, sequence, mission time in ms, accepted, the step after it in s).
+        let reports = [
+            (Input::Ownship, 2, 1, 10_000, true, 0.0),
+            (Input::Ownship, 7, 1, 9_500, true, 0.0),
+            (Input::Ownship, 2, 2, 10_100, true, 0.1),
+            (Input::Ownship, 7, 2, 9_600, true, 0.1),
+            (Input::LeadState, 2, 3, 10_150, true, 0.1),
+            // A repeated sequence is refused: its 0.3 s step does not count.
+            (Input::Ownship, 2, 2, 10_400, false, 0.1),
+            (Input::Ownship, 2, 4, 10_300, true, 0.2),
+        ];
+        for (input, sender, sequence, t_ms, accepted, step) in reports {
+            let header = Header::new(sender, sequence, t_ms * 1_000_000);
+            let result = w.accept_header(input, &header, Duration::ZERO);
+            assert_eq!(result.is_ok(), accepted, "{input:?} {sender} {sequence}");
+            assert!(
+                (w.ownship_step_s() - step).abs() < 1e-12,
+                "after {input:?} {sender} {sequence}: {} s",
+                w.ownship_step_s()
+            );
+        }
     }
 }
