@@ -191,10 +191,10 @@ pub fn candidates(
     ranking: StartRanking,
     cost: impl Fn(&Trajectory) -> f64 + Sync,
 ) -> Vec<Trajectory> {
-    let xy = |tr: &Trajectory| -> Vec<[f64; 3]> {
-        tr.states.iter().map(|s| problem.position(s)).collect()
-    };
-    let mut taken = vec![(signature(problem, &xy(first)), first.clone())];
+    let mut taken = vec![(
+        signature(problem, &positions(problem, first)),
+        first.clone(),
+    )];
     if count <= 1 {
         return vec![first.clone()];
     }
@@ -237,8 +237,7 @@ fn pick(
         if taken.len() >= upto {
             break;
         }
-        let points: Vec<[f64; 3]> = tr.states.iter().map(|s| problem.position(s)).collect();
-        let sig = signature(problem, &points);
+        let sig = signature(problem, &positions(problem, tr));
         let distinct = taken
             .iter()
             .all(|(t, o)| !same_class(t, &sig) || apart.is_some_and(|far| separation(o, tr) > far));
@@ -259,6 +258,11 @@ fn pick(
             taken.push((sig, tr.clone()));
         }
     }
+}
+
+/// The positions (`[x, y, z]`) of a path's samples.
+fn positions(problem: &Problem, tr: &Trajectory) -> Vec<[f64; 3]> {
+    tr.states.iter().map(|s| problem.position(s)).collect()
 }
 
 /// How far from a fixed final time, as a fraction of the time the plan has (`t_f - t_0`),
@@ -345,11 +349,8 @@ mod tests {
             "2d-min-time-unavoidable",
             "3d-min-time-rendezvous-avoidable",
         ] {
-            let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
-            let mut all = Vec::new();
-            seeds(&problem, &SeedSettings::default(), &mut all).unwrap();
+            let (problem, all, first) = seeded(name);
             assert!(all.len() > 8, "{name}: {} seeds", all.len());
-            let first = path_of_seed(&problem, &all[0]).expect("a path");
             let cost = |tr: &Trajectory| crate::hybrid::trajectory_cost(&problem, tr);
             let one = candidates(
                 &problem,
@@ -376,24 +377,30 @@ mod tests {
         }
     }
 
+    /// The bundled `name`'s problem, its default seeds, and the first seed's path (the
+    /// swarm's best stand-in).
+    fn seeded(name: &str) -> (Problem, Vec<Seed>, Trajectory) {
+        let problem = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
+        let mut all = Vec::new();
+        seeds(&problem, &SeedSettings::default(), &mut all).unwrap();
+        let first = path_of_seed(&problem, &all[0]).expect("a path");
+        (problem, all, first)
+    }
+
     /// With a fixed final time the starts after the swarm's best are seeds that arrive
     /// within 2 % of it (the bundled mission has more such seeds, of distinct classes or
     /// 10 km apart, than starts); on time means within 2 %, not 2.1 %.
     #[test]
     fn fixed_time_starts_arrive_on_time() {
-        let sc = bundled("2d-fixed-time-avoidable").unwrap().unwrap();
-        let problem = Problem::from_scenario(&sc).unwrap();
+        let (problem, all, first) = seeded("2d-fixed-time-avoidable");
         let tf = problem.final_time.unwrap();
         let t = tf - problem.t0;
-        let mut all = Vec::new();
-        seeds(&problem, &SeedSettings::default(), &mut all).unwrap();
         let late = all
             .iter()
             .filter_map(|s| path_of_seed(&problem, s))
             .filter(|tr| !arrives_on_time(&problem, tr))
             .count();
         assert!(late > 0, "some seeds arrive early or late");
-        let first = path_of_seed(&problem, &all[0]).expect("a path");
         let cost = |tr: &Trajectory| crate::hybrid::trajectory_cost(&problem, tr);
         let starts = candidates(
             &problem,
@@ -431,11 +438,7 @@ mod tests {
     /// on time first, beyond `count`.
     #[test]
     fn both_rankings_take_the_cheap_early_seeds_and_the_on_time_ones() {
-        let sc = bundled("2d-fixed-time-avoidable").unwrap().unwrap();
-        let problem = Problem::from_scenario(&sc).unwrap();
-        let mut all = Vec::new();
-        seeds(&problem, &SeedSettings::default(), &mut all).unwrap();
-        let first = path_of_seed(&problem, &all[0]).expect("a path");
+        let (problem, all, first) = seeded("2d-fixed-time-avoidable");
         let cost = |tr: &Trajectory| crate::hybrid::trajectory_cost(&problem, tr);
         let both = candidates(&problem, &first, &all, 5, 1, StartRanking::Both, cost);
         assert!(both.len() > 5, "{} starts", both.len());

@@ -8,8 +8,8 @@
 //! times the random seeds, the altitude profiles that descend or climb early and late
 //! beside the direct and the high ones, a swarm of 64 particles in 8 groups for 300
 //! iterations, 24 NLP starts from distinct basins (with a fixed final time 24 by cost and
-//! up to 23 more with the seeds that arrive on time first), 6 finalists within 50 % of the best, two
-//! refinement rounds.
+//! up to 23 more with the seeds that arrive on time first), 6 finalists within 50 % of the
+//! best, two refinement rounds.
 
 use std::time::Duration;
 

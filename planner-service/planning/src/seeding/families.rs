@@ -196,10 +196,10 @@ fn fit_specs(ctx: &Context, n_signs: usize, altitudes: &[Altitude], specs: &mut 
 /// pass the threats where it is cheapest), and on that leg, left or right, the one bulge
 /// (bisected from straight, up to 4 times the leg) that takes all the spare length. (With
 /// the other legs straight it repeats a common-ratio fit; where 4 legs' worth is still too
-/// short it arrives early, ranked as such.) A turn of radius `R` costs `u^2 = (V/R)^2`, so one wide
-/// loop through open space is cheaper than the same length spread as tighter bulges over
-/// every leg (the common-ratio fits), which is where the yardstick found the better plans
-/// of slack fixed-time missions.
+/// short it arrives early, ranked as such.) A turn of radius `R` costs `u^2 = (V/R)^2`,
+/// so one wide loop through open space is cheaper than the same length spread as tighter
+/// bulges over every leg (the common-ratio fits), which is where the yardstick found the
+/// better plans of slack fixed-time missions.
 fn one_leg_specs(ctx: &Context, altitudes: &[Altitude], specs: &mut Vec<Spec>) {
     let legs = ctx.legs;
     for &alt in altitudes {

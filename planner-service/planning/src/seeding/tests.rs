@@ -109,7 +109,8 @@ fn one_leg_fits_take_all_the_spare_length_on_one_leg() {
     let problem = crate::problem::Problem::from_scenario(&sc).unwrap();
     let mut out = Vec::new();
     seeds(&problem, &SeedSettings::default(), &mut out).unwrap();
-    let want = sc.vehicle.speed_mps * (sc.final_point.as_ref().unwrap().time_s.unwrap() - 0.0);
+    let t_f = sc.final_point.as_ref().unwrap().time_s.unwrap();
+    let want = sc.vehicle.speed_mps * (t_f - sc.start.time_s);
     let scan = out
         .iter()
         .find(|s| s.label.kind == SeedKind::Scan)
