@@ -295,7 +295,7 @@ fn pending_triggers_name_the_plan_by_priority() {
 }
 
 #[test]
-fn a_plan_short_of_optimal_is_refined_once_with_its_own_budget() {
+fn a_plan_short_of_optimal_or_into_a_new_threat_is_refined_once_with_its_own_budget() {
     // Fires: every quality short of `Optimal`, whatever re-plan made it.
     for q in [Quality::Feasible, Quality::SwarmOnly, Quality::Degraded] {
         for t in [
@@ -304,13 +304,30 @@ fn a_plan_short_of_optimal_is_refined_once_with_its_own_budget() {
             Trigger::LeadRoute,
             Trigger::Expiry,
         ] {
-            assert!(refine_due(true, q, t), "{q:?} after {t:?}");
+            assert!(refine_due(true, q, t, false), "{q:?} after {t:?}");
         }
     }
-    // Near misses: an optimal plan, a refinement's own plan, the setting off.
-    assert!(!refine_due(true, Quality::Optimal, Trigger::PopUp));
-    assert!(!refine_due(true, Quality::SwarmOnly, Trigger::Refine));
-    assert!(!refine_due(false, Quality::SwarmOnly, Trigger::PopUp));
+    // Fires too: an optimal plan that enters a threat the plan before it kept clear of.
+    for t in [Trigger::LeadRoute, Trigger::ScheduledReplan, Trigger::PopUp] {
+        assert!(refine_due(true, Quality::Optimal, t, true), "{t:?}");
+    }
+    // Near misses: an optimal plan clear of new threats, a refinement's own plan (short
+    // or into a new threat), the setting off.
+    assert!(!refine_due(true, Quality::Optimal, Trigger::PopUp, false));
+    assert!(!refine_due(
+        true,
+        Quality::SwarmOnly,
+        Trigger::Refine,
+        false
+    ));
+    assert!(!refine_due(true, Quality::Optimal, Trigger::Refine, true));
+    assert!(!refine_due(
+        false,
+        Quality::SwarmOnly,
+        Trigger::PopUp,
+        false
+    ));
+    assert!(!refine_due(false, Quality::Optimal, Trigger::PopUp, true));
     // Its budget is the refinement's only while nothing else is pending.
     let mut s = TriggerSet::default();
     assert!(!refine_only(s));

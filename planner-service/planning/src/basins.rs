@@ -191,12 +191,40 @@ pub fn candidates(
     ranking: StartRanking,
     cost: impl Fn(&Trajectory) -> f64 + Sync,
 ) -> Vec<Trajectory> {
-    let mut taken = vec![(
-        signature(problem, &positions(problem, first)),
-        first.clone(),
-    )];
     if count <= 1 {
         return vec![first.clone()];
+    }
+    more_candidates(
+        problem,
+        std::slice::from_ref(first),
+        seeds,
+        count,
+        threads,
+        ranking,
+        cost,
+    )
+}
+
+/// [`candidates`] after the starts already `taken` (a plan's waves, after its global
+/// search's starts): `taken` first, then up to `count` in all (`2 count - 1` with
+/// [`StartRanking::Both`]) chosen as [`candidates`] chooses them, distinct from `taken`
+/// too.
+pub fn more_candidates(
+    problem: &Problem,
+    taken: &[Trajectory],
+    seeds: &[Seed],
+    count: usize,
+    threads: usize,
+    ranking: StartRanking,
+    cost: impl Fn(&Trajectory) -> f64 + Sync,
+) -> Vec<Trajectory> {
+    let mut taken: Vec<(Signature, Trajectory)> = taken
+        .iter()
+        .map(|tr| (signature(problem, &positions(problem, tr)), tr.clone()))
+        .collect();
+    let more = count.saturating_sub(taken.len());
+    if more == 0 {
+        return taken.into_iter().map(|(_, tr)| tr).collect();
     }
     let fixed_time = problem.objective == Objective::FixedTime;
     // Each seed's path with its cost, index, and whether it arrives off time.
@@ -211,11 +239,11 @@ pub fn candidates(
     };
     if fixed_time && ranking == StartRanking::Both {
         ranked.sort_by(by_cost);
-        pick(problem, &ranked, count - 1, None, &mut taken);
+        pick(problem, &ranked, more, None, &mut taken);
     }
     ranked.sort_by(|a, b| a.2.cmp(&b.2).then(by_cost(a, b)));
     let apart = fixed_time.then_some(SLACK_SEPARATION_M);
-    pick(problem, &ranked, count - 1, apart, &mut taken);
+    pick(problem, &ranked, more, apart, &mut taken);
     taken.into_iter().map(|(_, tr)| tr).collect()
 }
 

@@ -184,6 +184,14 @@ impl<'c> Deadline<'c> {
         }
     }
 
+    /// This deadline, or `other`'s time if that comes first.
+    pub fn no_later_than(&self, other: &Deadline<'_>) -> Deadline<'c> {
+        Deadline {
+            at: self.at.min(other.at),
+            ..*self
+        }
+    }
+
     /// The clock this deadline runs on.
     pub fn clock(&self) -> &'c dyn Clock {
         self.clock

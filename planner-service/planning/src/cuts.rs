@@ -28,11 +28,26 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Part {
     /// The plan as a whole (which paths run).
-    Plan = 0,
+    Plan,
     /// A re-plan's warm path.
-    Warm = 1,
+    Warm,
     /// The global search.
-    Global = 2,
+    Global,
+    /// Wave `k` (from 1) of a plan from scratch: the next starts, solved with the time
+    /// the global search left (`hybrid::waves`).
+    Wave(u8),
+}
+
+impl Part {
+    /// The part's 8-bit code: 0-2, then 2 + k for wave k.
+    fn code(self) -> u32 {
+        match self {
+            Part::Plan => 0,
+            Part::Warm => 1,
+            Part::Global => 2,
+            Part::Wave(k) => 2 + u32::from(k.max(1)),
+        }
+    }
 }
 
 /// A piece of work the deadline may cut, within its [`Part`].
@@ -95,7 +110,7 @@ impl Site {
             Work::WinnerRound => (10, 0),
             Work::Refinement => (11, 0),
         };
-        (self.part as u32) << 24 | kind << 16 | index
+        self.part.code() << 24 | kind << 16 | index
     }
 
     /// The site of a 32-bit code (`None`: no site has it).
@@ -104,6 +119,7 @@ impl Site {
             0 => Part::Plan,
             1 => Part::Warm,
             2 => Part::Global,
+            k @ 3..=255 => Part::Wave((k - 2) as u8),
             _ => return None,
         };
         let index = code & 0xffff;
@@ -396,7 +412,13 @@ mod tests {
     #[test]
     fn every_site_survives_its_code() {
         let mut codes = Vec::new();
-        for part in [Part::Plan, Part::Warm, Part::Global] {
+        for part in [
+            Part::Plan,
+            Part::Warm,
+            Part::Global,
+            Part::Wave(1),
+            Part::Wave(253),
+        ] {
             for work in every_work() {
                 let site = Site { part, work };
                 assert_eq!(Site::from_code(site.code()), Some(site), "{site:?}");
@@ -407,7 +429,10 @@ mod tests {
         codes.sort_unstable();
         codes.dedup();
         assert_eq!(codes.len(), n, "two sites share a code");
-        assert_eq!(Site::from_code(3 << 24), None, "no fourth part");
+        assert_eq!(
+            Site::from_code(0xff << 24).map(|s| s.part),
+            Some(Part::Wave(253))
+        );
         assert_eq!(Site::from_code(12 << 16), None, "no kind 12");
         assert_eq!(
             Site::from_code(1 << 16 | 1),
@@ -493,7 +518,7 @@ mod tests {
         assert!(r.of(3).is_empty(), "a plan with no entry was not cut");
         let bad = ReplayCuts::parse("1 01000000:2\nx 2").unwrap_err();
         assert_eq!(bad.line, 2);
-        let unknown = ReplayCuts::parse("1 7f000000:2").unwrap_err();
+        let unknown = ReplayCuts::parse("1 020c0000:2").unwrap_err();
         assert!(unknown.problem.contains("no site"), "{unknown}");
         assert!(ReplayCuts::parse("1\n1").is_err(), "a plan twice");
     }

@@ -17,6 +17,7 @@ mod schedule;
 mod settings;
 mod timing;
 mod warm_start;
+mod waves;
 
 pub use exhaustive::{Exhaustive, ExhaustiveOutcome, plan_exhaustive};
 use nlp_stage::{Finaled, NlpStage, Ranked, Solved};
@@ -228,11 +229,13 @@ impl Planner {
             Some(warm) => {
                 // A warm plan is a better floor than the coarse one.
                 let floor_wanted = !warm.has_plan();
-                let mut outcome = self.global(problem, settings, global_deadline, floor_wanted)?;
+                let mut outcome =
+                    self.global(problem, settings, global_deadline, floor_wanted, false)?;
                 outcome.offer(warm);
                 outcome
             }
-            None => self.global(problem, settings, global_deadline, true)?,
+            // A plan from scratch: waves of further starts with the time it leaves.
+            None => self.global(problem, settings, global_deadline, true, true)?,
         };
         outcome.times.total = clock.now().saturating_sub(started);
         Ok(outcome)

@@ -71,6 +71,26 @@ fn a_cold_plan_cut_short_replays_byte_for_byte() {
     }
 }
 
+/// A take-off plan whose budget ends in its waves (`hybrid::waves`: the global search
+/// done, a wave not started or cut) replays byte for byte. Which budget ends there depends
+/// on the machine's speed: the shortest of a rising scale whose cuts include a wave's.
+#[test]
+fn a_take_off_plan_cut_in_its_waves_replays_byte_for_byte() {
+    let name = "2d-min-time-avoidable";
+    let (p, _) = planned(name);
+    let in_a_wave = |c: &Cut| matches!(c.site.part, Part::Wave(_));
+    let mut seen = Vec::new();
+    for budget_ms in [80, 120, 160, 240, 320, 480] {
+        let (a, b, recorded, taken) = cut_and_replayed(&p, None, Duration::from_millis(budget_ms));
+        if recorded.iter().any(in_a_wave) {
+            assert_same_plan(name, &a, &b, &recorded, &taken);
+            return;
+        }
+        seen.push((budget_ms, recorded));
+    }
+    panic!("{name}: no budget ended in a wave: {seen:?}");
+}
+
 #[test]
 fn a_warm_re_plan_cut_short_replays_byte_for_byte() {
     for (name, budget_ms) in [

@@ -121,3 +121,60 @@ fn a_plan_with_bad_settings_fails_before_it_starts() {
         })
     ));
 }
+
+/// The waves' settings out of range are refused, each by its name; the defaults and the
+/// yardstick's (no waves) pass.
+#[test]
+fn bad_wave_settings_are_refused_by_name() {
+    let cases: [(&str, PlannerSettings); 5] = [
+        (
+            "wave_starts",
+            PlannerSettings {
+                wave_starts: 201,
+                ..PlannerSettings::default()
+            },
+        ),
+        (
+            "wave_share",
+            PlannerSettings {
+                wave_share: 0.0,
+                ..PlannerSettings::default()
+            },
+        ),
+        (
+            "wave_share_3d",
+            PlannerSettings {
+                wave_share_3d: 1.5,
+                ..PlannerSettings::default()
+            },
+        ),
+        (
+            "wave_gap_tol",
+            PlannerSettings {
+                wave_gap_tol: f64::NAN,
+                ..PlannerSettings::default()
+            },
+        ),
+        (
+            "wave_gap_tol",
+            PlannerSettings {
+                wave_gap_tol: -0.1,
+                ..PlannerSettings::default()
+            },
+        ),
+    ];
+    for (name, settings) in cases {
+        match settings.validate() {
+            Err(PlannerSettingsError::OutOfRange { setting, .. }) => assert_eq!(setting, name),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+    assert_eq!(PlannerSettings::default().validate(), Ok(()));
+    assert_eq!(PlannerSettings::exhaustive(1).validate(), Ok(()));
+    let mut bad_seeds = PlannerSettings::default();
+    bad_seeds.wave_seeds.max_seeds = 0;
+    assert!(
+        bad_seeds.validate().is_err(),
+        "the waves' seeds are checked"
+    );
+}

@@ -216,12 +216,14 @@ pub fn expiry_due(now: f64, plan: &PlanWindow, lead_s: f64, holding: bool) -> bo
 
 /// Whether a plan just made is refined: it fell short of `Optimal` (a re-plan's short
 /// budget cut its NLP, leaving the swarm's path or an unconverged solution to fly, which
-/// may miss the end by hundreds of metres) and is not itself a refinement (one attempt,
-/// so a mission the NLP cannot solve does not plan on end). The refinement re-plans the
-/// plan in flight with its own budget, longer than a re-plan's ([`refine_only`]): the
-/// aircraft flies the short plan meanwhile.
-pub fn refine_due(enabled: bool, made: Quality, trigger: Trigger) -> bool {
-    enabled && made != Quality::Optimal && trigger != Trigger::Refine
+/// may miss the end by hundreds of metres), or it enters a known static threat that the
+/// plan before it kept clear of (`enters_new_threat`: a re-plan that converged in a basin
+/// across the threat), and it is not itself a refinement (one attempt, so a mission the
+/// NLP cannot solve does not plan on end). The refinement re-plans the plan in flight
+/// with its own budget, longer than a re-plan's ([`refine_only`]): the aircraft flies
+/// the short plan meanwhile.
+pub fn refine_due(enabled: bool, made: Quality, trigger: Trigger, enters_new_threat: bool) -> bool {
+    enabled && trigger != Trigger::Refine && (made != Quality::Optimal || enters_new_threat)
 }
 
 /// Whether the triggers `set` ask only for a refinement (it has its own budget, between a

@@ -76,6 +76,8 @@ impl PlannerSettings {
             .with_max_seeds(512)
             .with_scan_minima(5);
         s.starts = 24;
+        // Its own search stays as it was measured: no waves after it.
+        s.wave_starts = 0;
         s.start_ranking = StartRanking::Both;
         s.finalists = 6;
         s.finalist_gap_tol = 0.5;

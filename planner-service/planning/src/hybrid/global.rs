@@ -8,12 +8,14 @@ use wingman_interfaces::Quality;
 
 use super::nlp_stage::{self, NlpStage};
 use super::timing::{Ranking, Seen, SolveTiming, StageTiming};
+use super::waves::{self, Waves};
 use super::{
     Gathered, PlanError, PlanOutcome, PlanPath, PlanSolution, Planner, PlannerSettings, StageTimes,
     gather, ranking_meshes, reference_export, schedule, trajectory_cost,
 };
 use crate::basins;
 use crate::clock::Deadline;
+use crate::collocation::Mesh;
 use crate::collocation::{export, fly_reference};
 use crate::cuts::Work;
 use crate::problem::Problem;
@@ -35,16 +37,19 @@ impl Planner {
 
     /// The global search: seeds and swarm, the NLP stage over distinct starts, the
     /// refinement of the winner; with `floor_wanted`, under a budget that may not hold the
-    /// stage, first the floor (`nlp_stage::floor`).
+    /// stage, first the floor (`nlp_stage::floor`); with `widen` (a plan from scratch),
+    /// then the waves of further starts the time left holds (`waves`).
     pub(super) fn global(
         &mut self,
         problem: &Problem,
         settings: &PlannerSettings,
         deadline: Deadline<'static>,
         floor_wanted: bool,
+        widen: bool,
     ) -> Result<PlanOutcome, PlanError> {
         let clock = deadline.clock();
         let started = clock.now();
+        let waves_deadline = waves::deadline(problem, settings, deadline);
         let mut times = StageTimes::default();
         let model = usize::from(problem.dim() == 3);
         let (timing, stage_timing) = (self.timing[model], self.stage[model]);
@@ -66,24 +71,10 @@ impl Planner {
         let deadline = deadline.earlier(fallback_cost * 2);
 
         let nlp_started = clock.now();
-        // A budget that may not hold the stage (its ranking and a solve in a third of what
-        // is left, as recent plans took them: a stage that yields needs the finals and a
-        // round after its ranking, and the ranking's estimate decays while no plan tries
-        // it): first the floor, one coarse solve of the swarm's path, kept if the stage
-        // yields nothing.
-        let short = !stage_timing.fits_the_stage(&timing, deadline.remaining() / 3);
-        let floor_runs = |d: &Deadline<'static>| short && timing.fits_a_solve(d.remaining());
-        let floor = if floor_wanted && deadline.at(Work::Floor).cuts(0, floor_runs) {
-            Some(nlp_stage::floor(
-                problem, settings, &sw.best, deadline, timing, &self.kkt,
-            ))
-        } else {
-            None
-        };
-        // No time left for the ranking and one solve's set-up and wrap-up after it (as
-        // recent plans measured them): no NLP stage at all, not even its starts (2-3 ms of
-        // dense costs). (An expired deadline is one of these.) Asked again now: a swarm
-        // that converged early may have left the time for it.
+        let floor = self.floor_first(problem, settings, &sw.best, deadline, floor_wanted);
+        // No time for the ranking and one solve's set-up and wrap-up (as recent plans took
+        // them; an expired deadline too): no NLP stage, not even its starts. Asked again
+        // now: a swarm that converged early may have left the time.
         let no_time = deadline
             .at(Work::NlpStage)
             .cuts(0, |d| !stage_timing.fits_the_stage(&timing, d.remaining()));
@@ -101,6 +92,7 @@ impl Planner {
             fallback_start: &sw.best,
             reference: reference_export(settings),
             fallback_warm: None,
+            to_beat: None,
             timing,
             seen: Seen::default(),
             deadline,
@@ -114,12 +106,19 @@ impl Planner {
             schedule::run(&stage, settings.threads)
         };
         times.ranking = done.ranked_at.saturating_sub(nlp_started);
+        let gathered = gather(&stage, done, deadline)?;
         let Gathered {
             mut report,
             accepted,
             cut,
             first_optimal,
-        } = gather(&stage, done, deadline)?;
+        } = if widen && !no_time {
+            let took = clock.now().saturating_sub(nlp_started);
+            let waves = Waves::new(problem, settings, &starts, &sw.best, timing, took);
+            self.waves(waves, deadline.no_later_than(&waves_deadline), gathered)?
+        } else {
+            gathered
+        };
         let stage_yields = accepted.is_some();
         let (accepted, quality_of_floor) = match (accepted, floor) {
             (Some(a), _) => (Some(a), None),
@@ -180,6 +179,27 @@ impl Planner {
             times,
             solution: accepted.and_then(|(a, _)| PlanSolution::of(a)),
         })
+    }
+
+    /// With `wanted`, under a budget that may not hold the NLP stage (its ranking and a
+    /// solve in a third of what is left, as recent plans took them: a stage that yields
+    /// needs the finals and a round after its ranking, and the ranking's estimate decays
+    /// while no plan tries it): first the floor, one coarse solve of the swarm's path,
+    /// kept if the stage yields nothing.
+    fn floor_first(
+        &self,
+        problem: &Problem,
+        settings: &PlannerSettings,
+        swarm_best: &Trajectory,
+        deadline: Deadline<'static>,
+        wanted: bool,
+    ) -> Option<(nlp_stage::MeshSolveResult, Mesh)> {
+        let model = usize::from(problem.dim() == 3);
+        let (timing, stage_timing) = (self.timing[model], self.stage[model]);
+        let short = !stage_timing.fits_the_stage(&timing, deadline.remaining() / 3);
+        let floor_runs = |d: &Deadline<'static>| short && timing.fits_a_solve(d.remaining());
+        let runs = wanted && deadline.at(Work::Floor).cuts(0, floor_runs);
+        runs.then(|| nlp_stage::floor(problem, settings, swarm_best, deadline, timing, &self.kkt))
     }
 
     /// Starts from distinct basins, solved side by side on the first mesh. The swarm's

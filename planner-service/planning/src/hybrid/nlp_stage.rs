@@ -234,6 +234,10 @@ pub(super) struct NlpStage<'a> {
     /// The plan in flight's solution that the fallback candidate's solve takes its
     /// multipliers from (the warm path's plain solve; `warm::transfer_in_time`).
     pub(super) fallback_warm: Option<&'a PlanSolution>,
+    /// A wave's bar (`waves`): only starts ranked at or below this dense cost are
+    /// finalists, and no fallback is solved when none is (`None`: any start, and the
+    /// fallback).
+    pub(super) to_beat: Option<f64>,
     /// How ranked solutions are exported: densely, open loop.
     pub(super) reference: ExportSettings,
     /// The solves' timing learned from recent plans.
@@ -358,10 +362,15 @@ impl schedule::Stage for NlpStage<'_> {
             .iter()
             .enumerate()
             .filter_map(|(i, r)| r.and_then(|r| r.path.as_ref()).map(|(c, tr)| (*c, i, tr)))
+            .filter(|(c, _, _)| self.to_beat.is_none_or(|bar| *c <= bar))
             .collect();
         // Lowest cost first; ties go to the earlier start (deterministic).
         order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         finalists(&order, self.settings)
+    }
+
+    fn fallback_wanted(&self) -> bool {
+        self.to_beat.is_none()
     }
 
     fn finalist(&self, c: usize, rank: Option<&Ranked>, cancel: Arc<AtomicBool>) -> Finaled {

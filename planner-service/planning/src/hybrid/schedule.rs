@@ -33,6 +33,11 @@ pub(super) trait Stage: Sync {
     fn fallback(&self) -> usize {
         self.starts()
     }
+    /// Whether the fallback is solved when no start ranked (a wave, whose plan only
+    /// competes with one already made, wants none).
+    fn fallback_wanted(&self) -> bool {
+        true
+    }
     /// Ranks start `i`.
     fn rank(&self, i: usize) -> Self::Rank;
     /// The finalists, best first, among the ranks done so far (`ranks[i]` is `None` while
@@ -181,7 +186,7 @@ impl<S: Stage> Shared<S> {
         if ranked && board.chosen.is_none() {
             // 2. The finalists, on all the ranks.
             let mut chosen = stage.finalists(&self.done_ranks(board));
-            if chosen.is_empty() {
+            if chosen.is_empty() && stage.fallback_wanted() {
                 chosen.push(stage.fallback());
             }
             for (c, (cancel_final, cancel_round)) in
@@ -381,6 +386,7 @@ mod tests {
         final_objective: Vec<Option<f64>>,
         final_len: Vec<u64>,
         rounds: bool,
+        fallback_wanted: bool,
         panic_rank: Option<usize>,
         panic_final: Option<usize>,
         /// Solves started (speculative ones included) and cancelled.
@@ -401,6 +407,7 @@ mod tests {
                 final_objective: final_objective.to_vec(),
                 final_len: vec![3; final_objective.len()],
                 rounds: true,
+                fallback_wanted: true,
                 panic_rank: None,
                 panic_final: None,
                 started: AtomicUsize::new(0),
@@ -451,6 +458,10 @@ mod tests {
                 .collect();
             ranked.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             ranked.into_iter().take(2).map(|r| r.1).collect()
+        }
+
+        fn fallback_wanted(&self) -> bool {
+            self.fallback_wanted
         }
 
         fn finalist(&self, c: usize, rank: Option<&f64>, cancel: Arc<AtomicBool>) -> Self::Final {
@@ -623,5 +634,22 @@ mod tests {
         assert_eq!(s.finals, [Some((2, Some(7.0)))]);
         assert_eq!(s.winner, Some(0));
         assert_eq!(s.round, None);
+    }
+
+    /// A stage that wants no fallback (a wave) ends when nothing ranked: no final, no
+    /// winner, on one thread and on two.
+    #[test]
+    fn a_stage_without_a_fallback_ends_with_no_final_when_nothing_ranked() {
+        let fake = || {
+            let mut f = Fake::new(&[f64::NAN, f64::NAN], &[1, 1], &[None, None, Some(7.0)]);
+            f.fallback_wanted = false;
+            f
+        };
+        let (one, _, _, s) = one_and_two_threads(fake);
+        assert!(s.chosen.is_empty());
+        assert!(s.finals.is_empty());
+        assert_eq!(s.winner, None);
+        assert_eq!(s.round, None);
+        assert!(one.final_started.lock().unwrap().is_empty());
     }
 }

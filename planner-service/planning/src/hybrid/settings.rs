@@ -3,6 +3,7 @@
 
 use crate::basins::StartRanking;
 use crate::collocation::{ExportSettings, NlpSettings, RefineSettings, TranscriptionSettings};
+use crate::seeding::SeedSettings;
 use crate::swarm::{self, SwarmSettings};
 
 /// How each phase's first mesh is cut.
@@ -49,6 +50,22 @@ pub struct PlannerSettings {
     /// NLP starts from distinct basins: the swarm's best and the best seeds that pass some
     /// threat on another side (see `basins`).
     pub starts: usize,
+    /// A plan from scratch may solve starts up to this many in all: after its global
+    /// search, while time is left, the next `starts` of them at a time (a wave,
+    /// `hybrid::waves`); `starts` or fewer: no waves.
+    pub wave_starts: usize,
+    /// The seeds the waves' starts are drawn from (built by the first wave).
+    pub wave_seeds: SeedSettings,
+    /// How the waves' starts are ranked (a fixed-time plan's; see `basins::candidates`):
+    /// the starts of the global search are left out.
+    pub wave_ranking: StartRanking,
+    /// A wave's start is a finalist only if its ranked cost is at most the best ranked so
+    /// far by this (relative).
+    pub wave_gap_tol: f64,
+    /// The share of a 2-D plan's budget (from its start) within which waves run.
+    pub wave_share: f64,
+    /// The same in 3-D.
+    pub wave_share_3d: f64,
     /// How a fixed-time plan's seeds are ranked as starts (see `basins::candidates`).
     pub start_ranking: StartRanking,
     /// Threads solving the starts' NLPs side by side.
@@ -125,6 +142,20 @@ impl Default for PlannerSettings {
             swarm_share: 0.3,
             starts: 5, // six's worst cost, a 16 % shorter ranking; four lose basins (0021)
             start_ranking: StartRanking::OnTimeFirst,
+            // One wave: with four, the clock chose the course of 405 of 500 take-off
+            // plans; one fits the budget on most missions (0040).
+            wave_starts: 10,
+            // The yardstick's wider bulges and random curves (0040).
+            wave_seeds: SeedSettings::default()
+                .with_bulge_ratios(&[0.15, 0.3, 0.5, 0.8, 1.2])
+                .with_random_seeds(64)
+                .with_random_bulge_max(1.0)
+                .with_max_seeds(512),
+            wave_ranking: StartRanking::Both,
+            wave_gap_tol: 0.5, // 0.1 and 0.3 found no more (0040)
+            wave_share: 1.0,
+            // A 3-D take-off's whole 2.5 s on two threads fills the duty-cycle window.
+            wave_share_3d: 0.5,
             threads: 2, // the NLP tasks on two threads (0023)
             // Coarser meshes lose basins; four points only in 3-D (0012).
             ranking_mesh: MeshSettings {
@@ -175,6 +206,9 @@ impl PlannerSettings {
     /// planner's own, so that a bad setting is refused before a plan starts.
     pub fn validate(&self) -> Result<(), PlannerSettingsError> {
         self.swarm.validate()?;
+        self.wave_seeds
+            .validate()
+            .map_err(swarm::SwarmError::from)?;
         for (stage, nlp) in [
             ("nlp", &self.nlp),
             ("ranking_nlp", &self.ranking_nlp),
@@ -195,6 +229,18 @@ impl PlannerSettings {
         if !(1..=200).contains(&self.starts) {
             // A start's index names its solves' deadline cuts in 8 bits (`cuts::Work`).
             return out("starts", "must be in 1..=200");
+        }
+        if self.wave_starts > 200 {
+            // Each wave names its cuts' part in 8 bits (`cuts::Part::Wave`).
+            return out("wave_starts", "must be at most 200");
+        }
+        for (setting, value) in [
+            ("wave_share", self.wave_share),
+            ("wave_share_3d", self.wave_share_3d),
+        ] {
+            if !fraction(value) {
+                return out(setting, "must be in (0, 1]");
+            }
         }
         if !(1..=64).contains(&self.threads) {
             return out("threads", "must be in 1..=64");
@@ -217,6 +263,7 @@ impl PlannerSettings {
             ("ranking_feasibility_tol", self.ranking_feasibility_tol),
             ("finalist_duplicate_tol", self.finalist_duplicate_tol),
             ("finalist_gap_tol", self.finalist_gap_tol),
+            ("wave_gap_tol", self.wave_gap_tol),
         ] {
             if !non_negative(value) {
                 return out(setting, "must be finite and non-negative");

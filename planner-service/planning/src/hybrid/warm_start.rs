@@ -115,6 +115,7 @@ impl Planner {
                     && starts.is_empty()
                     && !deflect::near_new_threat(problem, &flying.threats, &guess, NEAR_NEW_F)
             }),
+            to_beat: None,
             reference: reference_export(settings),
             timing: self.timing[model],
             seen: Seen::default(),

@@ -11,7 +11,7 @@ use super::lifecycle::{FirstPlan, PlanLifecycle};
 use super::splice::NoSplice;
 use crate::service::solver::{SolveRequest, Ticket};
 use crate::service::triggers::{self, DeviationBounds, PlanWindow, PopupAssessment, TriggerSet};
-use crate::service::world::ThreatSlot;
+use crate::service::world::{self, ThreatSlot};
 
 /// The longest ownship step the time triggers' lead takes in, s (a stalled ownship feed
 /// must not make every plan expire at once).
@@ -103,6 +103,19 @@ impl MessageLoop {
             }
             (_, None) => None,
         }
+    }
+
+    /// The known static threats the current plan enters (F below `f_star` at one of its
+    /// samples from now on), by slot.
+    pub(super) fn static_threats_entered(&self) -> [bool; world::MAX_STATIC_THREATS] {
+        let mut entered = [false; world::MAX_STATIC_THREATS];
+        for (i, e) in entered.iter_mut().enumerate() {
+            *e = self.world.static_threat(i).is_some()
+                && self
+                    .assess_popup(ThreatSlot::Static(i))
+                    .is_some_and(|a| a.touches());
+        }
+        entered
     }
 
     /// Recomputes `t_r` of moving threat `i` over the current plan.

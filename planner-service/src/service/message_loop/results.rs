@@ -121,6 +121,8 @@ impl MessageLoop {
                  take its course"
             );
         }
+        // The known static threats the plan in flight enters, before it is replaced.
+        let entered_before = self.has_plan.then(|| self.static_threats_entered());
         // Scheduled re-plans of the moving threats over the new plan.
         self.points.fill(&self.scratch, speed);
         std::mem::swap(&mut self.current, &mut self.scratch);
@@ -156,10 +158,26 @@ impl MessageLoop {
             next_replan_s = self.current.next_replan(),
             "plan published"
         );
-        if triggers::refine_due(self.cfg.triggers.refine, o.quality, ticket.trigger) {
+        // A plan that enters a known static threat the plan before it kept clear of: a
+        // re-plan whose short budget left it in a basin across the threat (the plan in
+        // flight dragged across it by a new rendezvous, or pressed into it by a moving
+        // threat); the refinement's global search has the time to look around it.
+        let enters_new = entered_before.is_some_and(|before| {
+            let now = self.static_threats_entered();
+            now.iter()
+                .zip(&before)
+                .any(|(now, before)| *now && !*before)
+        });
+        if triggers::refine_due(
+            self.cfg.triggers.refine,
+            o.quality,
+            ticket.trigger,
+            enters_new,
+        ) {
             info!(
                 quality = o.quality.name(),
-                "plan short of optimal: refine it"
+                enters_new_threat = enters_new,
+                "plan short of optimal or into a threat the plan before avoided: refine it"
             );
             self.raise(Trigger::Refine);
         }
