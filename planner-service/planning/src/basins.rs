@@ -191,9 +191,6 @@ pub fn candidates(
     ranking: StartRanking,
     cost: impl Fn(&Trajectory) -> f64 + Sync,
 ) -> Vec<Trajectory> {
-    if count <= 1 {
-        return vec![first.clone()];
-    }
     more_candidates(
         problem,
         std::slice::from_ref(first),
