@@ -7,6 +7,8 @@
 //!   Gauss–Markov truth and noisy track fixes;
 //! - [`tracker`]: the inner-loop tracker — flies the newest plan with the vehicle model and
 //!   the tracking law, safe hold when no plan is valid, `OwnshipState`;
+//! - [`truth`]: the truth model — wind and gusts, the aircraft's lagged response and its
+//!   navigation errors (the scenario's `[wind]` and `[aircraft]`);
 //! - [`clock`]: fast (lock-step), real-time and scaled mission clocks;
 //! - [`link`]: the iceoryx2 ports (through the planner's `service::ipc`);
 //! - [`process`]: the planner as a child process;
@@ -33,6 +35,7 @@ pub mod report;
 pub mod resume;
 pub mod sensor;
 pub mod tracker;
+pub mod truth;
 
 use wingman_planning::scenario::{BUNDLED, Scenario, ScenarioError, bundled};
 

@@ -333,7 +333,7 @@ fn resumed_note(flight: &Flight) -> String {
     })
 }
 
-/// The timeline: exposure, deviation, re-plans.
+/// The timeline: exposure, deviation, re-plans, and the wind when the scenario has one.
 pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()> {
     let times: Vec<f64> = flight.samples.iter().map(|s| s.t).collect();
     let exposure = exposure_series(flight).map_err(boxed)?;
@@ -353,10 +353,14 @@ pub fn timeline(flight: &Flight, report: &Report, path: &Path) -> PlotResult<()>
             ("sans-serif", 24),
         )
         .map_err(boxed)?;
-    let panels = root.split_evenly((3, 1));
+    let windy = flight.scenario.wind.is_some();
+    let panels = root.split_evenly((if windy { 4 } else { 3 }, 1));
     exposure_panel(&panels[0], flight, report, (&times, &exposure), span)?;
     deviation_panel(&panels[1], flight, span)?;
     plans_panel(&panels[2], flight, span)?;
+    if windy {
+        wind_panel(&panels[3], flight, span)?;
+    }
     root.present().map_err(boxed)?;
     Ok(())
 }
@@ -472,6 +476,46 @@ where
         .map_err(boxed)?;
     }
     replan_lines(&mut c, flight, (-d_max, d_max))?;
+    legend(&mut c)
+}
+
+/// Panel 4 (a scenario with `[wind]`): the wind at the aircraft, each component.
+fn wind_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    flight: &Flight,
+    span: (f64, f64),
+) -> PlotResult<()>
+where
+    DB::ErrorType: 'static,
+{
+    let axes = flight.scenario.model.position_dim();
+    let w_max = flight
+        .samples
+        .iter()
+        .flat_map(|s| s.wind[..axes].iter().map(|w| w.abs()))
+        .fold(1.0, f64::max)
+        * 1.15;
+    let mut c = timeline_chart(
+        area,
+        "wind at the aircraft (truth: mean and gusts)",
+        span,
+        -w_max..w_max,
+        "wind [m/s]",
+    )?;
+    let colors = [
+        RGBColor(31, 119, 180),
+        RGBColor(255, 127, 14),
+        RGBColor(44, 160, 44),
+    ];
+    for (i, (name, color)) in ["x", "y", "z"].iter().zip(colors).take(axes).enumerate() {
+        c.draw_series(LineSeries::new(
+            flight.samples.iter().map(|s| (s.t, s.wind[i])),
+            color.stroke_width(1),
+        ))
+        .map_err(boxed)?
+        .label(format!("wind {name}"))
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color));
+    }
     legend(&mut c)
 }
 

@@ -5,6 +5,11 @@
 //! `OwnshipState` with its deviation from the plan, and flies a safe hold — a level turn —
 //! when the plan it flies is past its `valid_until` with no successor received (or it has
 //! no plan), logging each hold.
+//!
+//! With a truth model ([`crate::truth`]: the scenario's `[wind]` and `[aircraft]`) the
+//! tracker commands from the navigation solution, the aircraft answers with its own lag
+//! and limits (held over each step), the wind carries it over the ground, and
+//! `OwnshipState` reports the navigation solution; the samples keep the true state.
 
 use wingman_interfaces::{Model, OWNSHIP_HOLDING, OwnshipState, Plan, Wire};
 use wingman_planning::dynamics::{
@@ -12,6 +17,8 @@ use wingman_planning::dynamics::{
 };
 use wingman_planning::problem::Problem;
 use wingman_planning::tracking::{Deviation, Tracker, TrackingGains};
+
+use crate::truth::Truth;
 
 /// Longest integration step, s.
 pub const MAX_SUBSTEP_S: f64 = 0.05;
@@ -49,6 +56,8 @@ pub struct TrackerSample {
     pub plan_id: u64,
     pub holding: bool,
     pub deviation: Deviation,
+    /// The wind at the aircraft, m/s (0 in still air).
+    pub wind: [f64; 3],
 }
 
 /// The vehicle model.
@@ -72,6 +81,9 @@ pub struct InnerLoop {
     plans: Vec<ReceivedPlan>,
     flying: Option<usize>,
     holds: Vec<Hold>,
+    /// The wind, the aircraft's response and its navigation (`None`: the planner's model
+    /// in still air).
+    truth: Option<Truth>,
 }
 
 impl InnerLoop {
@@ -94,7 +106,16 @@ impl InnerLoop {
             plans: Vec::new(),
             flying: None,
             holds: Vec::new(),
+            truth: None,
         })
+    }
+
+    /// The tracker flying the aircraft and air of `truth` (`None`: the planner's model in
+    /// still air).
+    pub fn with_truth(mut self, truth: Option<Truth>) -> InnerLoop {
+        self.truth = truth;
+        self.update_deviation();
+        self
     }
 
     /// Takes a plan from the planner.
@@ -236,6 +257,10 @@ impl InnerLoop {
     }
 
     fn step(&mut self, h: f64) {
+        if self.truth.is_some() {
+            self.step_disturbed(h);
+            return;
+        }
         let t0 = self.t;
         let holding = self.holding();
         let plan = self.flying.map(|i| &*self.plans[i].plan);
@@ -273,11 +298,62 @@ impl InnerLoop {
         self.t = t0 + h;
     }
 
+    /// One step of the truth model: the command from the navigation solution, the
+    /// aircraft's response to it held over the step, the wind's drift.
+    fn step_disturbed(&mut self, h: f64) {
+        let t0 = self.t;
+        let sensed = self.sensed();
+        let command = self.command(t0, &sensed);
+        let Some(truth) = self.truth.as_mut() else {
+            return;
+        };
+        let applied = truth.respond(command, h);
+        let wind = truth.wind();
+        truth.advance(h);
+        let mut hold = |_: f64, _: &[f64; 3]| [applied[0]];
+        match self.vehicle {
+            Vehicle::Planar(m) => {
+                let x: [f64; 3] = [self.state[0], self.state[1], self.state[2]];
+                let next = rk4_step_with(&m, t0, &x, h, &mut hold);
+                self.state[..3].copy_from_slice(&next);
+            }
+            Vehicle::Spatial(m) => {
+                self.state = rk4_step_with(&m, t0, &self.state, h, &mut |_, _| applied);
+            }
+        }
+        if let Some(truth) = &self.truth {
+            truth.drift(&mut self.state, wind, h);
+        }
+        self.control = applied;
+        self.t = t0 + h;
+    }
+
+    /// The tracker's command at `t` for the state `x` it sees: the tracking law on the
+    /// flown plan, or the safe hold.
+    fn command(&self, t: f64, x: &[f64; 7]) -> [f64; 2] {
+        match (self.flying(), self.holding()) {
+            (Some(p), false) => {
+                let (xr, ur) = reference(&p.plan, t);
+                self.tracker.control(x, &xr, &ur)
+            }
+            _ => hold_control(self.model, &self.limits, x),
+        }
+    }
+
+    /// The state as the tracker sees it: the navigation solution (the true state without
+    /// a truth model).
+    fn sensed(&self) -> [f64; 7] {
+        self.truth
+            .as_ref()
+            .map_or(self.state, |truth| truth.sense(&self.state))
+    }
+
     fn update_deviation(&mut self) {
+        let sensed = self.sensed();
         self.deviation = match (self.flying(), self.holding()) {
             (Some(p), false) => {
                 let (xr, _) = reference(&p.plan, self.t);
-                self.tracker.deviation(&self.state, &xr)
+                self.tracker.deviation(&sensed, &xr)
             }
             _ => Deviation::default(),
         };
@@ -292,6 +368,7 @@ impl InnerLoop {
             plan_id: self.flying().map_or(0, |p| p.plan.plan_id),
             holding: self.holding(),
             deviation: self.deviation,
+            wind: self.truth.as_ref().map_or([0.0; 3], Truth::wind),
         }
     }
 
@@ -303,7 +380,7 @@ impl InnerLoop {
         m.model = self.model.to_wire();
         m.flags = if s.holding { OWNSHIP_HOLDING } else { 0 };
         m.plan_id = s.plan_id;
-        m.state = s.state;
+        m.state = self.sensed();
         m.control = s.control;
         m.cross_track_m = s.deviation.cross_m;
         m.along_track_m = s.deviation.along_m;

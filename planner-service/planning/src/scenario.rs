@@ -7,6 +7,7 @@
 //! cannot silently drop a setting.
 
 mod bundled;
+mod disturbance;
 mod error;
 pub mod messages;
 mod parse;
@@ -14,6 +15,7 @@ mod reader;
 mod types;
 
 pub use bundled::{BUNDLED, bundled, load_by_path_or_name};
+pub use disturbance::{AircraftSpec, GUST_LENGTH_M, GUSTS, WindSpec};
 pub use error::ScenarioError;
 pub use types::{
     Event, EventKind, FinalPoint, LeadSpec, MovingThreatSpec, Scenario, SensorSpec, Start,

@@ -3,7 +3,9 @@
 
 use std::path::{Path, PathBuf};
 use wingman_interfaces::{Model, Objective};
-use wingman_planning::scenario::{BUNDLED, EventKind, Scenario, bundled, load_by_path_or_name};
+use wingman_planning::scenario::{
+    BUNDLED, EventKind, GUST_LENGTH_M, Scenario, bundled, load_by_path_or_name,
+};
 
 fn scenarios_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios")
@@ -288,6 +290,48 @@ const BROKEN: &[Broken] = &[
         key: "moving_threats[0].truth.seed",
         problem: "non-negative integer",
     },
+    Broken {
+        base: "2d-fixed-time-avoidable",
+        from: "stiffness = 30.0\n",
+        to: "stiffness = 30.0\n[wind]\ngusts = \"stormy\"\n",
+        key: "wind.gusts",
+        problem: "unknown intensity",
+    },
+    Broken {
+        base: "2d-fixed-time-avoidable",
+        from: "stiffness = 30.0\n",
+        to: "stiffness = 30.0\n[wind]\ngusts = \"light\"\ngust_sigma_mps = 2.0\n",
+        key: "wind.gust_sigma_mps",
+        problem: "not both",
+    },
+    Broken {
+        base: "2d-fixed-time-avoidable",
+        from: "stiffness = 30.0\n",
+        to: "stiffness = 30.0\n[wind]\nmean_mps = [1.0, 2.0, 3.0]\n",
+        key: "wind.mean_mps",
+        problem: "list of 2 numbers",
+    },
+    Broken {
+        base: "2d-fixed-time-avoidable",
+        from: "stiffness = 30.0\n",
+        to: "stiffness = 30.0\n[aircraft]\nbank_rate_max_dps = 30.0\n",
+        key: "aircraft.bank_rate_max_dps",
+        problem: "unknown key",
+    },
+    Broken {
+        base: "3d-replan-popups",
+        from: "stiffness = 30.0\n",
+        to: "stiffness = 30.0\n[aircraft]\nresponse_s = -0.5\n",
+        key: "aircraft.response_s",
+        problem: "must not be negative",
+    },
+    Broken {
+        base: "3d-replan-popups",
+        from: "stiffness = 30.0\n",
+        to: "stiffness = 30.0\n[aircraft]\nseed = 1.5\n",
+        key: "aircraft.seed",
+        problem: "non-negative integer",
+    },
 ];
 
 #[test]
@@ -347,4 +391,51 @@ fn more_static_threats_than_the_planner_holds_are_refused() {
     let err = with(room + 1).unwrap_err();
     assert_eq!(err.key, "threats");
     assert!(err.problem.contains("17 static threats"), "{err}");
+}
+
+/// `[wind]` and `[aircraft]` are read in SI units and radians, with their defaults; a
+/// canonical file has neither (still air, the planner's model).
+#[test]
+fn wind_and_aircraft_tables_are_read_in_si() {
+    let dir = std::env::temp_dir().join(format!("wingman-windy-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let deg = std::f64::consts::PI / 180.0;
+    let base =
+        std::fs::read_to_string(scenarios_dir().join("2d-fixed-time-avoidable.toml")).unwrap();
+    let plain = Scenario::load(scenarios_dir().join("2d-fixed-time-avoidable.toml")).unwrap();
+    assert!(plain.wind.is_none() && plain.aircraft.is_none());
+    let windy = format!(
+        "{base}\n[wind]\nmean_mps = [10.0, -12.0]\ngusts = \"moderate\"\nseed = 11\n\
+         [aircraft]\nresponse_s = 0.8\nturn_accel_max_dps2 = 2.0\nnav_sigma_m = 10.0\n\
+         nav_heading_sigma_deg = 0.2\nseed = 5\n"
+    );
+    let path = dir.join("windy.toml");
+    std::fs::write(&path, windy).unwrap();
+    let sc = Scenario::load(&path).unwrap();
+    let wind = sc.wind.unwrap();
+    assert_eq!(wind.mean_mps, [10.0, -12.0, 0.0]);
+    assert_eq!(wind.gust_sigma_mps, 3.0);
+    assert_eq!(wind.gust_length_m, GUST_LENGTH_M);
+    assert_eq!(wind.seed, 11);
+    let a = sc.aircraft.unwrap();
+    assert_eq!(a.response_s, 0.8);
+    assert!((a.turn_accel_max - 2.0 * deg).abs() < 1e-15);
+    assert!((a.nav_heading_sigma - 0.2 * deg).abs() < 1e-15);
+    assert_eq!((a.nav_sigma_m, a.nav_tau_s, a.seed), (10.0, 1.0, 5));
+
+    // 3-D: a horizontal mean is enough; the rate limits default to the vehicle's.
+    let base = std::fs::read_to_string(scenarios_dir().join("3d-replan-popups.toml")).unwrap();
+    let path = dir.join("windy-3d.toml");
+    std::fs::write(
+        &path,
+        format!("{base}\n[wind]\nmean_mps = [5.0, 0.0]\n[aircraft]\nresponse_s = 0.3\n"),
+    )
+    .unwrap();
+    let sc = Scenario::load(&path).unwrap();
+    assert_eq!(sc.wind.unwrap().mean_mps, [5.0, 0.0, 0.0]);
+    let a = sc.aircraft.unwrap();
+    assert_eq!(a.nz_rate_max, sc.vehicle.nz_rate_max_per_s);
+    assert_eq!(a.mu_rate_max, sc.vehicle.bank_rate_max_rps);
+    assert!(a.turn_accel_max.is_infinite());
+    std::fs::remove_dir_all(&dir).unwrap();
 }

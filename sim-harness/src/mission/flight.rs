@@ -26,6 +26,7 @@ use crate::process::{PlannerProcess, planner_binary};
 use crate::resume::{self, ResumeError, Resumed, Timeline};
 use crate::sensor::{SensorOutput, ThreatSensor};
 use crate::tracker::{InnerLoop, ReceivedPlan, TrackerSample};
+use crate::truth::Truth;
 
 /// Flies `opts.scenario` end to end.
 pub fn fly(opts: &FlyOptions) -> Result<Flight, FlyError> {
@@ -91,7 +92,8 @@ impl<'o> InFlight<'o> {
         let problem = Problem::from_scenario(sc)?;
         let mut datalink = Datalink::new(sc)?;
         let mut sensor = ThreatSensor::new(sc)?;
-        let mut tracker = InnerLoop::new(&problem, TrackingGains::default())?;
+        let mut tracker =
+            InnerLoop::new(&problem, TrackingGains::default())?.with_truth(Truth::of(sc, &problem));
         let cfg = &opts.planner_config;
         cfg.validate()?;
         let vehicle = cfg.vehicle_id.clone();

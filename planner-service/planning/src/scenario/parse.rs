@@ -31,6 +31,8 @@ impl Reader<'_> {
                 "threats",
                 "moving_threats",
                 "events",
+                "wind",
+                "aircraft",
             ],
         )?;
         let name = self.string(root, "", "name")?;
@@ -110,23 +112,7 @@ impl Reader<'_> {
             }
         };
 
-        let mut threats = Vec::new();
-        let tables = self.tables(root, "threats")?;
-        if tables.len() > crate::threat::MAX_THREATS {
-            // A planner holds at most this many static threats (pop-ups included): more
-            // would fail the take-off plan or be dropped in flight.
-            return self.fail(
-                "threats",
-                format!(
-                    "{} static threats, more than the planner holds ({})",
-                    tables.len(),
-                    crate::threat::MAX_THREATS
-                ),
-            );
-        }
-        for (i, t) in tables.iter().enumerate() {
-            threats.push(self.static_threat(t, &format!("threats[{i}]"), dim)?);
-        }
+        let threats = self.static_threats(root, dim)?;
         let mut moving_threats = Vec::new();
         for (i, m) in self.tables(root, "moving_threats")?.iter().enumerate() {
             moving_threats.push(self.moving_threat(
@@ -145,6 +131,7 @@ impl Reader<'_> {
             }
             events.push(event);
         }
+        let (wind, aircraft) = self.disturbances(root, model, &vehicle)?;
         Ok(Scenario {
             name,
             summary,
@@ -160,7 +147,31 @@ impl Reader<'_> {
             threats,
             moving_threats,
             events,
+            wind,
+            aircraft,
         })
+    }
+
+    /// `[[threats]]`: at most what the planner holds.
+    fn static_threats(&self, root: &Table, dim: usize) -> Res<Vec<StaticThreatSpec>> {
+        let mut threats = Vec::new();
+        let tables = self.tables(root, "threats")?;
+        if tables.len() > crate::threat::MAX_THREATS {
+            // A planner holds at most this many static threats (pop-ups included): more
+            // would fail the take-off plan or be dropped in flight.
+            return self.fail(
+                "threats",
+                format!(
+                    "{} static threats, more than the planner holds ({})",
+                    tables.len(),
+                    crate::threat::MAX_THREATS
+                ),
+            );
+        }
+        for (i, t) in tables.iter().enumerate() {
+            threats.push(self.static_threat(t, &format!("threats[{i}]"), dim)?);
+        }
+        Ok(threats)
     }
 
     pub(super) fn vehicle(&self, v: &Table, model: Model) -> Res<VehicleLimits> {
@@ -428,15 +439,7 @@ impl Reader<'_> {
             Some(Value::Table(truth)) => {
                 let truth_ctx = join(ctx, "truth");
                 self.only(truth, &truth_ctx, &["seed"])?;
-                match self.get(truth, &truth_ctx, "seed")? {
-                    Value::Integer(s) if *s >= 0 => *s as u64,
-                    other => {
-                        return self.fail(
-                            join(&truth_ctx, "seed"),
-                            format!("must be a non-negative integer, got {other}"),
-                        );
-                    }
-                }
+                self.seed(truth, &truth_ctx, "seed")?
             }
             Some(other) => {
                 return self.fail(

@@ -128,6 +128,26 @@ impl Reader<'_> {
         }
     }
 
+    /// A non-negative integer seed `t[key]`.
+    pub(super) fn seed(&self, t: &Table, ctx: &str, key: &str) -> Res<u64> {
+        match self.get(t, ctx, key)? {
+            Value::Integer(s) if *s >= 0 => Ok(*s as u64),
+            other => self.fail(
+                join(ctx, key),
+                format!("must be a non-negative integer, got {other}"),
+            ),
+        }
+    }
+
+    /// [`Reader::seed`], or `default` when `t` has no `key`.
+    pub(super) fn seed_or(&self, t: &Table, ctx: &str, key: &str, default: u64) -> Res<u64> {
+        if t.contains_key(key) {
+            self.seed(t, ctx, key)
+        } else {
+            Ok(default)
+        }
+    }
+
     /// A list of exactly `n` numbers, zero-padded to 3.
     pub(super) fn value_vector(
         &self,

@@ -7,6 +7,7 @@ use std::path::Path;
 use toml::Table;
 use wingman_interfaces::{Model, Objective, VehicleLimits, Weights};
 
+use super::disturbance::{AircraftSpec, WindSpec};
 use super::error::ScenarioError;
 use super::reader::Reader;
 
@@ -152,6 +153,10 @@ pub struct Scenario {
     pub threats: Vec<StaticThreatSpec>,
     pub moving_threats: Vec<MovingThreatSpec>,
     pub events: Vec<Event>,
+    /// The wind the harness flies (`None`: still air).
+    pub wind: Option<WindSpec>,
+    /// How the real aircraft differs from the planner's model (`None`: not at all).
+    pub aircraft: Option<AircraftSpec>,
 }
 
 impl Scenario {
