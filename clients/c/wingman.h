@@ -1,4 +1,4 @@
-/* wingman.h: the wingman planner's message contract for C and C++ (protocol 4).
+/* wingman.h: the wingman planner's message contract for C and C++ (protocol 5).
  * Generated from the Rust code (`WINGMAN_BLESS=1 cargo test -p wingman-ipc --test
  * contract`); do not edit. Layouts are little-endian, `#[repr(C)]`, with no implicit
  * padding; docs/INTERFACES.md says what each field means. */
@@ -17,7 +17,7 @@
 #endif
 
 /* Constants */
-#define WINGMAN_PROTOCOL_VERSION 4
+#define WINGMAN_PROTOCOL_VERSION 5
 #define WINGMAN_MAX_TARGETS 8
 #define WINGMAN_MAX_PHASES 9
 #define WINGMAN_MAX_ROUTE_POINTS 16
@@ -189,12 +189,13 @@ typedef struct wingman_Tasking {
     double final_state[7]; /* Final state for `FixedTime` and `MinTime` (model order, zero-padded); zeros for a rendezvous. [m, rad, g] */
     double final_time_s; /* Fixed final time for `FixedTime`; 0 otherwise. [s] */
     double targets_m[8][3]; /* Intermediate targets in order, `[x, y, z]` (z = 0 in 2-D); `target_count` valid. [m] */
+    double wind_mps[3]; /* The steady wind to plan in, `[x, y, z]` (the air mass's velocity; z = 0 in 2-D; zeros: still air). Slower than `limits.speed_mps`. [m/s] */
 #ifdef __cplusplus
     static constexpr const char *IOX2_TYPE_NAME = "wingman::Tasking";
 #endif
 } wingman_Tasking;
 #define WINGMAN_TASKING_TYPE_NAME "wingman::Tasking"
-WINGMAN_STATIC_ASSERT(sizeof(wingman_Tasking) == 456, "size of wingman_Tasking");
+WINGMAN_STATIC_ASSERT(sizeof(wingman_Tasking) == 480, "size of wingman_Tasking");
 WINGMAN_STATIC_ASSERT(WINGMAN_ALIGNOF(wingman_Tasking) == 8, "alignment of wingman_Tasking");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_Tasking, header) == 0, "offset of wingman_Tasking.header");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_Tasking, revision) == 24, "offset of wingman_Tasking.revision");
@@ -208,6 +209,7 @@ WINGMAN_STATIC_ASSERT(offsetof(wingman_Tasking, start_state) == 144, "offset of 
 WINGMAN_STATIC_ASSERT(offsetof(wingman_Tasking, final_state) == 200, "offset of wingman_Tasking.final_state");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_Tasking, final_time_s) == 256, "offset of wingman_Tasking.final_time_s");
 WINGMAN_STATIC_ASSERT(offsetof(wingman_Tasking, targets_m) == 264, "offset of wingman_Tasking.targets_m");
+WINGMAN_STATIC_ASSERT(offsetof(wingman_Tasking, wind_mps) == 456, "offset of wingman_Tasking.wind_mps");
 
 /* The lead's state from the datalink (periodic). */
 typedef struct wingman_LeadState {

@@ -48,7 +48,7 @@ pub use validate::{Checked, ValidationError};
 pub use iceoryx2::prelude::ZeroCopySend;
 
 /// Version of this contract. A message carrying another version is rejected.
-pub const PROTOCOL_VERSION: u32 = 4;
+pub const PROTOCOL_VERSION: u32 = 5;
 
 /// Intermediate targets in one tasking.
 pub const MAX_TARGETS: usize = 8;

@@ -71,6 +71,9 @@ wire_struct! {
         pub final_time_s: f64 ["s"],
         /// Intermediate targets in order, `[x, y, z]` (z = 0 in 2-D); `target_count` valid.
         pub targets_m: [[f64; 3]; MAX_TARGETS] ["m"],
+        /// The steady wind to plan in, `[x, y, z]` (the air mass's velocity; z = 0 in
+        /// 2-D; zeros: still air). Slower than `limits.speed_mps`.
+        pub wind_mps: [f64; 3] ["m/s"],
     }
 }
 
@@ -133,6 +136,13 @@ impl Message for Tasking {
                 validate::positive("limits.nz_rate_max_per_s", l.nz_rate_max_per_s)?;
                 validate::positive("limits.bank_rate_max_rps", l.bank_rate_max_rps)?;
             }
+        }
+        let wind = self.wind_mps.iter().map(|w| w * w).sum::<f64>().sqrt();
+        if wind >= l.speed_mps {
+            return Err(ValidationError::OutOfRange {
+                field: "wind_mps",
+                problem: "the wind must be slower than limits.speed_mps",
+            });
         }
         let w = &self.weights;
         validate::within("weights.alpha", w.alpha, 0.0, 1.0, "must be in [0, 1]")?;

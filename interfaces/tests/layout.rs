@@ -60,7 +60,7 @@ fn tasking_layout() {
     );
     pin::<Weights>(24, 8, &[("alpha", 0), ("beta", 8), ("stiffness", 16)]);
     pin::<Tasking>(
-        456,
+        480,
         8,
         &[
             ("header", 0),
@@ -75,6 +75,7 @@ fn tasking_layout() {
             ("final_state", 200),
             ("final_time_s", 256),
             ("targets_m", 264),
+            ("wind_mps", 456),
         ],
     );
 }

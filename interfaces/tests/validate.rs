@@ -97,6 +97,21 @@ fn tasking_is_checked() {
             ..
         })
     ));
+    // A wind as fast as the aircraft leaves no plan; one just slower is accepted.
+    let mut m = common::tasking();
+    let v = m.limits.speed_mps;
+    m.wind_mps = [0.6 * v, 0.8 * v, 0.0];
+    assert!(matches!(
+        m.validate(),
+        Err(ValidationError::OutOfRange {
+            field: "wind_mps",
+            ..
+        })
+    ));
+    m.wind_mps = [0.6 * v, 0.79 * v, 0.0];
+    assert!(m.validate().is_ok());
+    m.wind_mps[2] = f64::NAN;
+    rejects(&m, ValidationError::NonFinite { field: "wind_mps" });
 }
 
 #[test]

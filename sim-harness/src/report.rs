@@ -118,6 +118,11 @@ pub struct Report {
     pub final_error_m: f64,
     /// `end_s` minus the fixed final time (fixed-time missions), s.
     pub final_time_error_s: Option<f64>,
+    /// When the aircraft reached the final point against the fixed final time
+    /// (fixed-time missions), s: the time of its closest approach, or, still short of it
+    /// at the end, the end plus the distance left along its track over its ground speed.
+    /// Negative: early.
+    pub arrival_time_error_s: Option<f64>,
     /// Smallest `F` of any static threat along the flown path (pop-ups included).
     pub min_f_static: Option<f64>,
     /// Smallest `F` of any moving threat's true keep-out region while it exists.
@@ -371,6 +376,12 @@ pub fn build(flight: &Flight) -> Result<Report, ThreatError> {
             .map(|r| end_t - r.tasking.final_time_s),
         _ => None,
     };
+    let arrival_time_error_s = match (sc.objective, flight.datalink.taskings().last()) {
+        (Objective::FixedTime, Some(r)) => {
+            arrival_time(&flight.samples, sc.model, goal, end_t).map(|t| t - r.tasking.final_time_s)
+        }
+        _ => None,
+    };
     let min_of = |kind: &str| {
         m.threats
             .iter()
@@ -439,6 +450,7 @@ pub fn build(flight: &Flight) -> Result<Report, ThreatError> {
         end_position_m: end_pos,
         final_error_m,
         final_time_error_s,
+        arrival_time_error_s,
         min_f_static: min_of("static"),
         min_f_moving: min_of("moving"),
         threats: m.threats,
@@ -485,4 +497,46 @@ fn state_at(samples: &[crate::tracker::TrackerSample], t: f64) -> [f64; 7] {
         (None, Some(b)) => b.state,
         (None, None) => [0.0; 7],
     }
+}
+
+/// When the flight reached `goal`: the time of its closest approach up to `end_t`; if
+/// that is the end itself (still short of it), the end plus the distance left along the
+/// track over the ground speed there. `None` without samples.
+fn arrival_time(
+    samples: &[crate::tracker::TrackerSample],
+    model: Model,
+    goal: [f64; 3],
+    end_t: f64,
+) -> Option<f64> {
+    let flown: Vec<_> = samples.iter().filter(|s| s.t <= end_t).collect();
+    let distance = |s: &crate::tracker::TrackerSample| {
+        let p = position(model, &s.state);
+        p.iter()
+            .zip(goal)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let (k, closest) = flown
+        .iter()
+        .enumerate()
+        .min_by(|a, b| distance(a.1).total_cmp(&distance(b.1)))?;
+    if k + 1 < flown.len() || k == 0 {
+        return Some(closest.t);
+    }
+    let before = flown[k - 1];
+    let (p0, p1) = (
+        position(model, &before.state),
+        position(model, &closest.state),
+    );
+    let dt = closest.t - before.t;
+    let velocity: Vec<f64> = p1.iter().zip(p0).map(|(a, b)| (a - b) / dt).collect();
+    let speed = velocity.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let left: f64 = goal
+        .iter()
+        .zip(p1)
+        .zip(&velocity)
+        .map(|((g, p), v)| (g - p) * v / speed)
+        .sum();
+    Some(closest.t + left.max(0.0) / speed)
 }

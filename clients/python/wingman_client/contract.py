@@ -1,4 +1,4 @@
-"""The wingman planner's message contract (protocol 4), as Python ctypes.
+"""The wingman planner's message contract (protocol 5), as Python ctypes.
 
 Generated from the Rust code (`WINGMAN_BLESS=1 cargo test -p wingman-ipc --test contract`);
 do not edit. Layouts are little-endian and `repr(C)` with no implicit padding;
@@ -7,7 +7,7 @@ docs/INTERFACES.md says what each field means.
 
 import ctypes
 
-PROTOCOL_VERSION = 4
+PROTOCOL_VERSION = 5
 MAX_TARGETS = 8
 MAX_PHASES = 9
 MAX_ROUTE_POINTS = 16
@@ -204,9 +204,10 @@ class Tasking(ctypes.Structure):
         ("final_state", (ctypes.c_double * 7)),
         ("final_time_s", ctypes.c_double),
         ("targets_m", ((ctypes.c_double * 3) * 8)),
+        ("wind_mps", (ctypes.c_double * 3)),
     ]
 
-    SIZE = 456
+    SIZE = 480
     ALIGN = 8
 
     @staticmethod

@@ -146,6 +146,9 @@ pub struct SolverConfig {
     /// name, is read too.)
     #[serde(alias = "swarm_threads")]
     pub threads: usize,
+    /// Plans as if in still air, whatever wind the tasking gives (`Tasking.wind_mps`): the
+    /// comparison a wind-aware plan is measured against. false: plans in that wind.
+    pub still_air: bool,
 }
 
 impl Default for ServiceConfig {
@@ -220,6 +223,7 @@ impl Default for SolverConfig {
         SolverConfig {
             seed: 1,
             threads: 2,
+            still_air: false,
         }
     }
 }

@@ -256,18 +256,29 @@ pub trait OdeModel<const NX: usize, const NU: usize> {
 // 2-D model
 // -------------------------------------------------------------------------------------------
 
-/// The 2-D model, eq. (3.8): `x' = V cos psi, y' = V sin psi, psi' = u`.
+/// The 2-D model, eq. (3.8): `x' = V cos psi + w_x, y' = V sin psi + w_y, psi' = u`, with
+/// `psi` the heading through the air and `w` a steady wind (0 unless set, `with_wind`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Planar {
     speed: f64,
+    wind: [f64; 3],
 }
 
 impl Planar {
-    /// A 2-D model flying at `speed` (finite, positive).
+    /// A 2-D model flying at `speed` (finite, positive) in still air.
     pub fn new(speed: f64) -> Result<Self, DynamicsError> {
         Ok(Self {
             speed: positive("speed", speed)?,
+            wind: [0.0; 3],
         })
+    }
+
+    /// The model in the steady wind `wind` (m/s; its vertical part is ignored).
+    pub fn with_wind(self, wind: [f64; 3]) -> Self {
+        Self {
+            wind: [wind[0], wind[1], 0.0],
+            ..self
+        }
     }
 
     /// The constant speed `V`.
@@ -302,7 +313,9 @@ impl Planar {
 impl OdeModel<3, 1> for Planar {
     fn rhs(&self, x: &State2, u: &Control2) -> State2 {
         let (s, c) = x[idx2::PSI].sin_cos();
-        [self.speed * c, self.speed * s, u[0]]
+        let mut f = [self.speed * c, self.speed * s, u[0]];
+        drift(&mut f, &self.wind);
+        f
     }
 
     fn jac_x(&self, x: &State2, _u: &Control2) -> SMatrix<f64, 3, 3> {
@@ -329,19 +342,29 @@ impl OdeModel<3, 1> for Planar {
 /// y' = V cos gamma sin chi      chi'   = g Nz sin mu / (V cos gamma)
 /// z' = V sin gamma              Nz' = u1,   mu' = u2
 /// ```
+///
+/// with `chi` the heading and `gamma` the flight-path angle through the air; a steady wind
+/// `w` (0 unless set, `with_wind`) adds to `x', y', z'`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Spatial {
     speed: f64,
     g: f64,
+    wind: [f64; 3],
 }
 
 impl Spatial {
-    /// A 3-D model flying at `speed` (finite, positive) with `g = G0`.
+    /// A 3-D model flying at `speed` (finite, positive) with `g = G0`, in still air.
     pub fn new(speed: f64) -> Result<Self, DynamicsError> {
         Ok(Self {
             speed: positive("speed", speed)?,
             g: G0,
+            wind: [0.0; 3],
         })
+    }
+
+    /// The model in the steady wind `wind` (m/s).
+    pub fn with_wind(self, wind: [f64; 3]) -> Self {
+        Self { wind, ..self }
     }
 
     /// The constant speed `V`.
@@ -410,11 +433,13 @@ impl Spatial {
         })
     }
 
-    /// Inertial velocity `(x', y', z')` of a state.
+    /// Velocity over the ground `(x', y', z')` of a state: through the air, plus the wind.
     pub fn velocity(&self, x: &State3) -> [f64; 3] {
         let (sg, cg) = x[idx3::GAMMA].sin_cos();
         let (sc, cc) = x[idx3::CHI].sin_cos();
-        [self.speed * cg * cc, self.speed * cg * sc, self.speed * sg]
+        let mut v = [self.speed * cg * cc, self.speed * cg * sc, self.speed * sg];
+        drift(&mut v, &self.wind);
+        v
     }
 }
 
@@ -473,18 +498,26 @@ impl OdeModel<7, 2> for Spatial {
 // -------------------------------------------------------------------------------------------
 
 /// The reduced 3-D model of the swarm, eq. (5.11): states `x, y, z`, "controls"
-/// `gamma, chi`: `x' = V cos gamma cos chi, y' = V cos gamma sin chi, z' = V sin gamma`.
+/// `gamma, chi`: `x' = V cos gamma cos chi, y' = V cos gamma sin chi, z' = V sin gamma`,
+/// plus a steady wind (0 unless set, `with_wind`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reduced {
     speed: f64,
+    wind: [f64; 3],
 }
 
 impl Reduced {
-    /// A reduced model flying at `speed` (finite, positive).
+    /// A reduced model flying at `speed` (finite, positive), in still air.
     pub fn new(speed: f64) -> Result<Self, DynamicsError> {
         Ok(Self {
             speed: positive("speed", speed)?,
+            wind: [0.0; 3],
         })
+    }
+
+    /// The model in the steady wind `wind` (m/s).
+    pub fn with_wind(self, wind: [f64; 3]) -> Self {
+        Self { wind, ..self }
     }
 
     /// The constant speed `V`.
@@ -516,7 +549,9 @@ impl OdeModel<3, 2> for Reduced {
     fn rhs(&self, _x: &StateReduced, u: &ControlReduced) -> StateReduced {
         let (sg, cg) = u[0].sin_cos();
         let (sc, cc) = u[1].sin_cos();
-        [self.speed * cg * cc, self.speed * cg * sc, self.speed * sg]
+        let mut f = [self.speed * cg * cc, self.speed * cg * sc, self.speed * sg];
+        drift(&mut f, &self.wind);
+        f
     }
 
     fn jac_x(&self, _x: &StateReduced, _u: &ControlReduced) -> SMatrix<f64, 3, 3> {
@@ -535,6 +570,18 @@ impl OdeModel<3, 2> for Reduced {
             v * cg,
             0.0,
         )
+    }
+}
+
+/// Adds a steady wind to the position rates `f[..3]` (nothing in still air, so that a
+/// still-air model computes exactly what it did before winds existed). A constant wind
+/// leaves every Jacobian and Hessian of the models unchanged.
+#[inline]
+fn drift<const N: usize>(f: &mut [f64; N], wind: &[f64; 3]) {
+    if *wind != [0.0; 3] {
+        for (fi, w) in f.iter_mut().zip(wind) {
+            *fi += w;
+        }
     }
 }
 

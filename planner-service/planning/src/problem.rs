@@ -85,6 +85,9 @@ pub struct Problem {
     /// The lead for `MinTimeRendezvous`.
     pub lead: Option<LeadPath>,
     pub threats: Threats,
+    /// The steady wind the plan is made in, m/s `[x, y, z]` (`z` 0 in 2-D; all 0: still
+    /// air): the models fly through the air and drift with it over the ground.
+    pub wind: [f64; 3],
 }
 
 impl Problem {
@@ -229,6 +232,7 @@ impl Problem {
             final_time: sc.final_point.as_ref().and_then(|f| f.time_s),
             lead,
             threats,
+            wind: sc.wind.as_ref().map_or([0.0; 3], |w| w.mean_mps),
         };
         problem.validate()?;
         Ok(problem)
@@ -240,6 +244,13 @@ impl Problem {
         let bad = |m: String| Err(ProblemError::Invalid(m));
         if !self.t0.is_finite() || self.x0.iter().any(|v| !v.is_finite()) {
             return bad("the start time and state must be finite".into());
+        }
+        let wind_speed = self.wind.iter().map(|w| w * w).sum::<f64>().sqrt();
+        if !wind_speed.is_finite() || wind_speed >= self.limits.speed {
+            return bad(format!(
+                "the wind ({wind_speed} m/s) must be finite and slower than the airspeed ({} m/s)",
+                self.limits.speed
+            ));
         }
         if self.targets.len() > MAX_TARGETS {
             return bad(format!(

@@ -333,12 +333,22 @@ fn split<const N: usize, const M: usize, const Z: usize>(z: &[f64; Z]) -> ([f64;
     )
 }
 
+/// Still air, and a steady wind of 25 m/s with a vertical part (the 2-D model keeps the
+/// horizontal part).
+const WINDS: [[f64; 3]; 2] = [[0.0; 3], [15.0, -20.0, 3.0]];
+
 #[test]
 fn jacobians_match_central_differences() {
+    for wind in WINDS {
+        jacobians_match_central_differences_in(wind);
+    }
+}
+
+fn jacobians_match_central_differences_in(wind: [f64; 3]) {
     let mut rng = ChaCha8Rng::seed_from_u64(0x5eed_0001);
-    let planar = Planar::new(180.0).unwrap();
-    let spatial = Spatial::new(230.0).unwrap();
-    let reduced = Reduced::new(230.0).unwrap();
+    let planar = Planar::new(180.0).unwrap().with_wind(wind);
+    let spatial = Spatial::new(230.0).unwrap().with_wind(wind);
+    let reduced = Reduced::new(230.0).unwrap().with_wind(wind);
     for _ in 0..50 {
         // 2-D
         let x: [f64; 3] = [
@@ -379,10 +389,16 @@ fn jacobians_match_central_differences() {
 
 #[test]
 fn second_derivatives_match_central_differences() {
+    for wind in WINDS {
+        second_derivatives_match_central_differences_in(wind);
+    }
+}
+
+fn second_derivatives_match_central_differences_in(wind: [f64; 3]) {
     let mut rng = ChaCha8Rng::seed_from_u64(0x5eed_0002);
-    let spatial = Spatial::new(230.0).unwrap();
-    let planar = Planar::new(180.0).unwrap();
-    let reduced = Reduced::new(230.0).unwrap();
+    let spatial = Spatial::new(230.0).unwrap().with_wind(wind);
+    let planar = Planar::new(180.0).unwrap().with_wind(wind);
+    let reduced = Reduced::new(230.0).unwrap().with_wind(wind);
     for _ in 0..50 {
         let z: [f64; 9] = [
             rng.random_range(-1e4..1e4),
@@ -449,5 +465,35 @@ fn second_derivatives_match_central_differences() {
                 "reduced component {k}"
             );
         }
+    }
+}
+
+/// In a steady wind every model's position rates are its still-air rates plus the wind
+/// (the 2-D model's horizontal part), its other rates unchanged, to rounding (1e-12).
+#[test]
+fn a_steady_wind_adds_to_the_position_rates() {
+    let w = WINDS[1];
+    let (x2, u2) = ([100.0, -50.0, 0.7], [0.03]);
+    let still = Planar::new(180.0).unwrap().rhs(&x2, &u2);
+    let windy = Planar::new(180.0).unwrap().with_wind(w).rhs(&x2, &u2);
+    let expected = [still[0] + w[0], still[1] + w[1], still[2]];
+    for i in 0..3 {
+        assert!((windy[i] - expected[i]).abs() <= 1e-12, "2-D {i}");
+    }
+    let x3 = [0.0, 0.0, 5000.0, 0.1, 1.2, 1.3, 0.4];
+    let u3 = [0.2, -0.1];
+    let still = Spatial::new(230.0).unwrap().rhs(&x3, &u3);
+    let windy = Spatial::new(230.0).unwrap().with_wind(w).rhs(&x3, &u3);
+    for i in 0..7 {
+        let expected = still[i] + if i < 3 { w[i] } else { 0.0 };
+        assert!((windy[i] - expected).abs() <= 1e-12, "3-D {i}");
+    }
+    let still = Reduced::new(230.0).unwrap().rhs(&[0.0; 3], &[0.1, 1.2]);
+    let windy = Reduced::new(230.0)
+        .unwrap()
+        .with_wind(w)
+        .rhs(&[0.0; 3], &[0.1, 1.2]);
+    for i in 0..3 {
+        assert!((windy[i] - still[i] - w[i]).abs() <= 1e-12, "reduced {i}");
     }
 }

@@ -52,7 +52,8 @@ pub fn tasking_decision(held: Option<&Tasking>, received: &Tasking) -> TaskingDe
         && held.weights == received.weights
         && held.targets() == received.targets()
         && held.final_state == received.final_state
-        && held.final_time_s == received.final_time_s;
+        && held.final_time_s == received.final_time_s
+        && held.wind_mps == received.wind_mps;
     if same {
         TaskingDecision::Unchanged
     } else {

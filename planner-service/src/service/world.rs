@@ -535,6 +535,10 @@ impl World {
             _ => Some(t.final_state),
         };
         out.final_time = (objective == Objective::FixedTime).then_some(t.final_time_s);
+        out.wind = match model {
+            Model::TwoD => [t.wind_mps[0], t.wind_mps[1], 0.0],
+            Model::ThreeD => t.wind_mps,
+        };
         out.lead = match objective {
             Objective::MinTimeRendezvous => {
                 let r = self.route.as_ref().ok_or(BuildError::NoRoute)?;
@@ -625,6 +629,7 @@ pub fn reusable_problem() -> Problem {
             layout: ThreatLayout::new(1.0).expect("positive placeholder stiffness"),
             moving: Vec::with_capacity(MAX_MOVING_THREATS),
         },
+        wind: [0.0; 3],
     }
 }
 

@@ -14,7 +14,8 @@ use super::{FinalPoint, Scenario, StaticThreatSpec};
 pub struct TooManyTargets(pub usize);
 
 /// The tasking of `sc` with `targets` and `final_point` (header left for the sender); in
-/// 2-D the targets' third coordinate is 0.
+/// 2-D the targets' third coordinate is 0. The wind to plan in is the mean of the
+/// scenario's `[wind]` (the gusts are not known ahead).
 pub fn tasking(
     sc: &Scenario,
     revision: u32,
@@ -35,6 +36,9 @@ pub fn tasking(
     if let Some(f) = final_point {
         t.final_state = f.state(sc.model);
         t.final_time_s = f.time_s.unwrap_or(0.0);
+    }
+    if let Some(w) = &sc.wind {
+        t.wind_mps = w.mean_mps;
     }
     t.target_count = targets.len() as u32;
     for (slot, p) in t.targets_m.iter_mut().zip(targets) {

@@ -283,7 +283,11 @@ impl MessageLoop {
             error!("the problem buffers are missing; no plan");
             return true;
         };
-        match self.world.fill_problem(&splice, &mut problem) {
+        let filled = self.world.fill_problem(&splice, &mut problem);
+        if self.cfg.solver.still_air {
+            problem.wind = [0.0; 3];
+        }
+        match filled {
             Ok(0) => {}
             Ok(skipped) => warn!(skipped, "threats that do not fit the model were left out"),
             Err(e) => {

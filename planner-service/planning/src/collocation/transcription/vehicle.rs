@@ -40,11 +40,18 @@ impl Vehicle {
     pub fn new(problem: &Problem) -> Vehicle {
         // The limits were checked when the problem was built, so the speed is positive.
         let v = problem.limits.speed;
+        let wind = problem.wind;
         match problem.model {
-            Model::TwoD => Vehicle::Planar(Planar::new(v).unwrap_or_else(|_| unreachable_speed(v))),
-            Model::ThreeD => {
-                Vehicle::Spatial(Spatial::new(v).unwrap_or_else(|_| unreachable_speed(v)))
-            }
+            Model::TwoD => Vehicle::Planar(
+                Planar::new(v)
+                    .unwrap_or_else(|_| unreachable_speed(v))
+                    .with_wind(wind),
+            ),
+            Model::ThreeD => Vehicle::Spatial(
+                Spatial::new(v)
+                    .unwrap_or_else(|_| unreachable_speed(v))
+                    .with_wind(wind),
+            ),
         }
     }
 
