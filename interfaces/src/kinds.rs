@@ -83,6 +83,10 @@ wire_enum! {
         /// re-plan): it is planned again, from the last plan the NLP made, with the longer
         /// refinement budget.
         Refine = 8,
+        /// The lead left the route it announced, without a new route: its observed state
+        /// moves the predicted meeting point beyond the configured distance. The
+        /// rendezvous is re-planned with the lead flying on as observed.
+        LeadOffRoute = 9,
     }
 }
 

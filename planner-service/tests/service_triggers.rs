@@ -204,6 +204,58 @@ fn a_lead_route_change_fires_only_with_a_larger_revision_and_another_route() {
     );
 }
 
+/// The lead on `route(1, 200 km)` (east at 150 m/s from the origin at t = 0) observed at
+/// t = 100 s at `position`, heading `heading_deg`, at `speed`.
+fn observed(position: [f64; 3], heading_deg: f64, speed: f64) -> LeadState {
+    let mut s = LeadState::zeroed();
+    s.time_s = 100.0;
+    s.position_m = position;
+    s.heading_rad = heading_deg.to_radians();
+    s.speed_mps = speed;
+    s.route_revision = 1;
+    s
+}
+
+/// Meeting at t = 500 s (400 s ahead): a lead on its route is 0 m off; one 2 degrees off
+/// its heading drifts 150 * 400 * 2 sin(1 deg) = 2 094 m by then (bound 1 000 m: fires),
+/// 0.5 degree drifts 524 m (does not); 3 m/s faster drifts 1 200 m (fires), 2 m/s 800 m
+/// (does not); 1.1 km aside now fires at once. Checked against that geometry to 1e-6 m.
+#[test]
+fn a_lead_off_its_route_fires_beyond_the_bound_at_the_meeting_time() {
+    let r = route(1, 200000.0);
+    let path = wingman_planning::lead::LeadPath::new(r.points(), r.speed_mps, 0.0).unwrap();
+    let off = |s: &LeadState| lead_off_route_m(&path, s, 500.0);
+    let bound = ServiceConfig::default().triggers.lead_off_route_m;
+    assert_eq!(bound, 1000.0);
+    let on = [15000.0, 0.0, 0.0];
+    assert!(off(&observed(on, 0.0, 150.0)).abs() < 1e-6);
+    for (heading, speed, expected) in [
+        (2.0, 150.0, 150.0 * 400.0 * 2.0 * 1.0f64.to_radians().sin()),
+        (0.5, 150.0, 150.0 * 400.0 * 2.0 * 0.25f64.to_radians().sin()),
+        (0.0, 153.0, 1200.0),
+        (0.0, 152.0, 800.0),
+    ] {
+        let d = off(&observed(on, heading, speed));
+        assert!(
+            (d - expected).abs() < 1e-6,
+            "{heading} deg, {speed} m/s: {d} against {expected}"
+        );
+        assert_eq!(d > bound, expected > bound);
+    }
+    assert!(off(&observed([15000.0, 1100.0, 0.0], 0.0, 150.0)) > bound);
+    // Met already: only where it is counts.
+    assert!(lead_off_route_m(&path, &observed(on, 30.0, 150.0), 90.0).abs() < 1e-6);
+    // The re-plan meets the lead as observed: that route puts it where it is, going on
+    // as it goes, so the same state is on it.
+    let s = observed([15000.0, 300.0, 0.0], 20.0, 160.0);
+    let o = observed_route(&s, 1);
+    assert_eq!((o.revision, o.start_time_s, o.speed_mps), (1, 100.0, 160.0));
+    let flown =
+        wingman_planning::lead::LeadPath::new(o.points(), o.speed_mps, o.start_time_s).unwrap();
+    let d = lead_off_route_m(&flown, &s, 500.0);
+    assert!(d < 1e-6, "{d}");
+}
+
 fn ownship(plan_id: u64, cross: f64, vertical: f64) -> OwnshipState {
     let mut o = OwnshipState::zeroed();
     o.plan_id = plan_id;
@@ -217,10 +269,16 @@ fn a_deviation_fires_beyond_the_bound_on_the_plan_flown() {
     let b = DeviationBounds {
         cross_m: 500.0,
         vertical_m: 200.0,
+        along_m: 300.0,
     };
     assert!(deviation_exceeded(&ownship(7, -500.5, 0.0), 7, &b));
     assert!(deviation_exceeded(&ownship(7, 0.0, 200.5), 7, &b));
     assert!(!deviation_exceeded(&ownship(7, 499.5, -199.5), 7, &b));
+    let mut behind = ownship(7, 0.0, 0.0);
+    behind.along_track_m = -300.5;
+    assert!(deviation_exceeded(&behind, 7, &b));
+    behind.along_track_m = 299.5;
+    assert!(!deviation_exceeded(&behind, 7, &b));
     // Reported against an older plan (the tracker has not switched yet): not ours.
     assert!(!deviation_exceeded(&ownship(6, 900.0, 0.0), 7, &b));
     // Flying a safe hold: that is the expiry trigger's case.
@@ -289,6 +347,8 @@ fn pending_triggers_name_the_plan_by_priority() {
     s.insert(Trigger::ScheduledReplan);
     assert!(!s.only_popups());
     assert_eq!(s.primary(), Some(Trigger::PopUp));
+    s.insert(Trigger::LeadOffRoute);
+    assert_eq!(s.primary(), Some(Trigger::LeadOffRoute));
     s.insert(Trigger::Tasking);
     assert_eq!(s.primary(), Some(Trigger::Tasking));
     assert!(s.contains(Trigger::ScheduledReplan) && !s.contains(Trigger::Expiry));

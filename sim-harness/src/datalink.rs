@@ -1,6 +1,7 @@
 //! The lead's datalink: the tasking (at start and at every `targets` / `final` event), the
 //! lead's route (at start and at every `lead-route` event) and its periodic state along
-//! the route in force. Pure: it says what to send at a mission time; the mission sends it.
+//! the route it flies — the route announced, or after a `lead-off-route` event one it
+//! never announced. Pure: it says what to send at a mission time; the mission sends it.
 
 use wingman_interfaces::{LeadRoute, LeadState, MAX_ROUTE_POINTS, MAX_TARGETS, Tasking, Wire};
 use wingman_planning::lead::{LeadError, LeadPath, LeadPoint};
@@ -42,7 +43,10 @@ pub struct RouteRevision {
 #[derive(Debug, Clone)]
 pub struct Datalink {
     taskings: Vec<TaskingRevision>,
+    /// The routes announced (each one sent).
     routes: Vec<RouteRevision>,
+    /// The routes the lead flies, announced or not, in time order.
+    flown: Vec<RouteRevision>,
     taskings_sent: usize,
     routes_sent: usize,
 }
@@ -56,8 +60,10 @@ impl Datalink {
             tasking: first,
         }];
         let mut routes = Vec::new();
+        let mut flown = Vec::new();
         if let Some(lead) = &sc.lead {
             routes.push(route(1, sc.start.time_s, &lead.route_m, lead.speed_mps)?);
+            flown.push(routes[0]);
         }
         let mut events: Vec<_> = sc.events.iter().collect();
         events.sort_by(|a, b| a.at_s.total_cmp(&b.at_s));
@@ -66,6 +72,12 @@ impl Datalink {
                 EventKind::LeadRoute { route_m, speed_mps } => {
                     let revision = routes.len() as u32 + 1;
                     routes.push(route(revision, e.at_s, route_m, *speed_mps)?);
+                    flown.extend(routes.last());
+                }
+                EventKind::LeadOffRoute { route_m, speed_mps } => {
+                    // The lead still reports the revision it announced last.
+                    let revision = routes.len() as u32;
+                    flown.push(route(revision, e.at_s, route_m, *speed_mps)?);
                 }
                 EventKind::Targets { targets_m } => {
                     let prev = taskings.last().map(|r| r.tasking).unwrap_or(first);
@@ -93,6 +105,7 @@ impl Datalink {
         Ok(Datalink {
             taskings,
             routes,
+            flown,
             taskings_sent: 0,
             routes_sent: 0,
         })
@@ -134,23 +147,30 @@ impl Datalink {
         &self.routes
     }
 
-    /// The route the lead flies at `t` (the newest whose time has come).
+    /// The route announced for `t` (the newest whose time has come).
     pub fn route_at(&self, t: f64) -> Option<&RouteRevision> {
-        self.routes
-            .iter()
-            .rev()
-            .find(|r| r.at_s <= t + 1e-9)
-            .or(self.routes.first())
+        newest_at(&self.routes, t)
+    }
+
+    /// The route the lead flies at `t`, announced or not.
+    pub fn flown_route_at(&self, t: f64) -> Option<&RouteRevision> {
+        newest_at(&self.flown, t)
+    }
+
+    /// Every route the lead flies, announced or not, in time order.
+    pub fn flown_routes(&self) -> &[RouteRevision] {
+        &self.flown
     }
 
     /// The lead's true state at `t`.
     pub fn lead_at(&self, t: f64) -> Option<LeadPoint> {
-        self.route_at(t).map(|r| r.path.at(t))
+        self.flown_route_at(t).map(|r| r.path.at(t))
     }
 
-    /// The `LeadState` message at `t` (header left for the sender).
+    /// The `LeadState` message at `t` (header left for the sender): the lead's true state
+    /// and the revision of the route it announced last.
     pub fn lead_state(&self, t: f64) -> Option<LeadState> {
-        let r = self.route_at(t)?;
+        let r = self.flown_route_at(t)?;
         let p = r.path.at(t);
         let mut m = LeadState::zeroed();
         m.time_s = t;
@@ -161,6 +181,15 @@ impl Datalink {
         m.route_revision = r.message.revision;
         Some(m)
     }
+}
+
+/// The newest of `routes` whose time has come by `t` (the first before any).
+fn newest_at(routes: &[RouteRevision], t: f64) -> Option<&RouteRevision> {
+    routes
+        .iter()
+        .rev()
+        .find(|r| r.at_s <= t + 1e-9)
+        .or(routes.first())
 }
 
 fn route(

@@ -89,6 +89,9 @@ pub struct TriggerConfig {
     pub deviation_cross_m: f64,
     /// A vertical deviation beyond this re-plans (3-D), m.
     pub deviation_vertical_m: f64,
+    /// Being ahead of or behind the plan beyond this re-plans, m (a constant airspeed
+    /// cannot make it up; a gust or a wind the plan did not know builds it up).
+    pub deviation_along_m: f64,
     /// A scheduled re-plan time `t_r` is looked for only this long after a plan's start,
     /// s: a plan just made from the newest estimate is not re-made at once.
     pub replan_min_lead_s: f64,
@@ -102,6 +105,10 @@ pub struct TriggerConfig {
     /// planned again once, from the last plan the NLP made, with the `refine_*_ms` budget
     /// (`Refine`).
     pub refine: bool,
+    /// A rendezvous re-plans (`LeadOffRoute`) when the lead's observed state, flown on
+    /// straight, would put it this far from where the held route puts it at the planned
+    /// meeting time, m: a lead that turned or changed speed without a new route.
+    pub lead_off_route_m: f64,
 }
 
 /// Inputs that stop arriving are reported in `PlannerStatus::stale_inputs` (wall clock).
@@ -187,9 +194,11 @@ impl Default for TriggerConfig {
             f_star: 1.0,
             deviation_cross_m: 500.0,
             deviation_vertical_m: 200.0,
+            deviation_along_m: 300.0,
             replan_min_lead_s: 1.0,
             first_plan_wait_ms: 300,
             refine: true,
+            lead_off_route_m: 1000.0,
         }
     }
 }
@@ -328,6 +337,8 @@ impl ServiceConfig {
         for (key, v) in [
             ("triggers.deviation_cross_m", t.deviation_cross_m),
             ("triggers.deviation_vertical_m", t.deviation_vertical_m),
+            ("triggers.deviation_along_m", t.deviation_along_m),
+            ("triggers.lead_off_route_m", t.lead_off_route_m),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return bad(key, format!("must be positive, got {v}"));

@@ -90,7 +90,7 @@ impl LeadPath {
 
     /// The lead's state at time `t` (allocation-free).
     pub fn at(&self, t: f64) -> LeadPoint {
-        let moving = t > self.t0;
+        let moving = t >= self.t0;
         let dist = self.speed * (t - self.t0).max(0.0);
         // Segment k spans cumulative[k]..cumulative[k + 1]; the last one extends forever.
         let last = self.len - 2;

@@ -14,7 +14,7 @@ mod parse;
 mod reader;
 mod types;
 
-pub use bundled::{BUNDLED, bundled, load_by_path_or_name};
+pub use bundled::{BUNDLED, DISTURBED, bundled, load_by_path_or_name};
 pub use disturbance::{AircraftSpec, GUST_LENGTH_M, GUSTS, WindSpec};
 pub use error::ScenarioError;
 pub use types::{

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use wingman_interfaces::{Model, Objective};
 use wingman_planning::scenario::{
-    BUNDLED, EventKind, GUST_LENGTH_M, Scenario, bundled, load_by_path_or_name,
+    BUNDLED, DISTURBED, EventKind, GUST_LENGTH_M, Scenario, bundled, load_by_path_or_name,
 };
 
 fn scenarios_dir() -> PathBuf {
@@ -438,4 +438,43 @@ fn wind_and_aircraft_tables_are_read_in_si() {
     assert_eq!(a.mu_rate_max, sc.vehicle.bank_rate_max_rps);
     assert!(a.turn_accel_max.is_infinite());
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `DISTURBED` bundles exactly `scenarios/disturbed/*.toml`, each the same text as its
+/// file, each loading, and each with what it is there for.
+#[test]
+fn the_disturbed_scenarios_are_bundled_and_load() {
+    let dir = scenarios_dir().join("disturbed");
+    let mut files: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().to_string())
+        .collect();
+    files.sort();
+    let names: Vec<String> = DISTURBED.iter().map(|(n, _)| n.to_string()).collect();
+    assert_eq!(
+        files, names,
+        "DISTURBED lists exactly scenarios/disturbed/*.toml"
+    );
+    for (name, text) in DISTURBED {
+        let file = std::fs::read_to_string(dir.join(format!("{name}.toml"))).unwrap();
+        assert_eq!(&file, text, "{name}");
+        let sc = bundled(name).unwrap().unwrap();
+        assert_eq!(sc.name, *name);
+    }
+    let windy = bundled("2d-fixed-time-windy").unwrap().unwrap();
+    assert!(windy.wind.is_some() && windy.objective == Objective::FixedTime);
+    let rough = bundled("3d-rendezvous-turbulence").unwrap().unwrap();
+    assert!(rough.wind.unwrap().gust_sigma_mps == 3.0 && rough.aircraft.is_some());
+    let off = bundled("2d-rendezvous-lead-off-route").unwrap().unwrap();
+    assert!(
+        off.events
+            .iter()
+            .any(|e| matches!(e.kind, EventKind::LeadOffRoute { .. }))
+    );
+    let busy = bundled("2d-four-targets-two-moving-threats")
+        .unwrap()
+        .unwrap();
+    assert!(busy.targets.len() >= 3 && busy.moving_threats.len() >= 2);
 }

@@ -10,6 +10,8 @@
 //! - a tasking change: a larger revision with other targets, final point, objective,
 //!   model, limits or weights ([`tasking_decision`]);
 //! - a lead route change: a larger revision with another route ([`route_decision`]);
+//! - a lead that leaves its route without a new one: its observed state moves the
+//!   predicted meeting point beyond a bound ([`lead_off_route_m`]);
 //! - the scheduled `t_r` of a moving threat that touches the plan (eqs. 7.1–7.6,
 //!   [`scheduled_replan`]), acted on one plan budget early so the new plan commits at
 //!   `t_r` ([`scheduled_due`]);
@@ -19,7 +21,9 @@
 //! - a plan made short of `Optimal` (its deadline cut the NLP), refined once with a
 //!   longer budget ([`refine_due`]).
 
-use wingman_interfaces::{LeadRoute, OwnshipState, Quality, Tasking, Trigger};
+use wingman_interfaces::{LeadRoute, LeadState, OwnshipState, Quality, Tasking, Trigger, Wire};
+
+use wingman_planning::lead::LeadPath;
 
 use wingman_planning::estimation::MovingThreat;
 use wingman_planning::replan::{self, PlanPoint, PopupHit, ReplanTime};
@@ -86,6 +90,51 @@ pub fn route_decision(held: Option<&LeadRoute>, received: &LeadRoute) -> RouteDe
     } else {
         RouteDecision::Changed
     }
+}
+
+/// How far the lead, flown on straight from its observed state `s`, would be at the
+/// meeting time `meet_at_s` from where `route` puts it then, m: the difference of the two
+/// now, plus the difference of their velocities over the time left (0 once met).
+pub fn lead_off_route_m(route: &LeadPath, s: &LeadState, meet_at_s: f64) -> f64 {
+    let on_route = route.at(s.time_s);
+    let observed = lead_velocity(s);
+    let ahead = (meet_at_s - s.time_s).max(0.0);
+    (0..3)
+        .map(|i| {
+            let now = s.position_m[i] - on_route.position[i];
+            let drift = (observed[i] - on_route.velocity[i]) * ahead;
+            (now + drift).powi(2)
+        })
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// The route the lead flies as observed in `s`: straight on from its position at its
+/// heading, flight-path angle and speed, from `s.time_s` (`revision` kept: the route it
+/// stands for), long enough for any mission.
+pub fn observed_route(s: &LeadState, revision: u32) -> LeadRoute {
+    const AHEAD_M: f64 = 2.0e6;
+    let v = lead_velocity(s);
+    let speed = s.speed_mps.max(f64::MIN_POSITIVE);
+    let mut r = LeadRoute::zeroed();
+    r.revision = revision;
+    r.point_count = 2;
+    r.start_time_s = s.time_s;
+    r.speed_mps = s.speed_mps;
+    r.points_m[0] = s.position_m;
+    r.points_m[1] = std::array::from_fn(|i| s.position_m[i] + v[i] / speed * AHEAD_M);
+    r
+}
+
+/// The lead's velocity in `s`, from its heading, flight-path angle and speed.
+fn lead_velocity(s: &LeadState) -> [f64; 3] {
+    let (sg, cg) = s.gamma_rad.sin_cos();
+    let (sc, cc) = s.heading_rad.sin_cos();
+    [
+        s.speed_mps * cg * cc,
+        s.speed_mps * cg * sc,
+        s.speed_mps * sg,
+    ]
 }
 
 /// A pop-up assessed against the remaining plan.
@@ -160,6 +209,9 @@ pub const TIME_TOLERANCE_S: f64 = 1e-6;
 pub struct DeviationBounds {
     pub cross_m: f64,
     pub vertical_m: f64,
+    /// Ahead of or behind the plan: at a constant airspeed only a new plan makes up for
+    /// it, and a rendezvous or a fixed final time needs it made up.
+    pub along_m: f64,
 }
 
 /// Whether the ownship, flying the plan `current_plan_id`, deviates from it beyond the
@@ -174,7 +226,8 @@ pub fn deviation_exceeded(
         && ownship.plan_id == current_plan_id
         && !ownship.holding()
         && (ownship.cross_track_m.abs() > bounds.cross_m
-            || ownship.vertical_m.abs() > bounds.vertical_m)
+            || ownship.vertical_m.abs() > bounds.vertical_m
+            || ownship.along_track_m.abs() > bounds.along_m)
 }
 
 /// The current plan's time window.
@@ -247,11 +300,12 @@ pub fn first_plan_trigger(tasking: &Tasking, ownship: Option<&OwnshipState>) -> 
 pub struct TriggerSet(u32);
 
 /// Triggers in the order the plan message names them when several are pending.
-const PRIORITY: [Trigger; 9] = [
+const PRIORITY: [Trigger; 10] = [
     Trigger::Initial,
     Trigger::Restart,
     Trigger::Tasking,
     Trigger::LeadRoute,
+    Trigger::LeadOffRoute,
     Trigger::PopUp,
     Trigger::Deviation,
     Trigger::ScheduledReplan,

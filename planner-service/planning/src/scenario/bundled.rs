@@ -12,6 +12,12 @@ macro_rules! bundled {
             include_str!(concat!("../../../../scenarios/", $name, ".toml")),
         )
     };
+    ($dir:literal / $name:literal) => {
+        (
+            $name,
+            include_str!(concat!("../../../../scenarios/", $dir, "/", $name, ".toml")),
+        )
+    };
 }
 
 /// The canonical scenarios shipped with the project (`scenarios/*.toml`), by name.
@@ -33,12 +39,32 @@ pub const BUNDLED: &[(&str, &str)] = &[
     bundled!("3d-replan-popups"),
 ];
 
-/// A bundled scenario by name.
+/// The disturbed-flight scenarios (`scenarios/disturbed/*.toml`): wind and turbulence,
+/// an aircraft that is not the planner's model, a lead that leaves its route, many targets
+/// and moving threats. Bundled like the canonical ones, flown by the test suite; the
+/// customer's reference optima cover only the canonical set.
+pub const DISTURBED: &[(&str, &str)] = &[
+    bundled!("disturbed" / "2d-fixed-time-windy"),
+    bundled!("disturbed" / "2d-four-targets-two-moving-threats"),
+    bundled!("disturbed" / "2d-rendezvous-lead-off-route"),
+    bundled!("disturbed" / "3d-rendezvous-turbulence"),
+];
+
+/// A bundled scenario by name, canonical or disturbed.
 pub fn bundled(name: &str) -> Option<Result<Scenario, ScenarioError>> {
-    BUNDLED
+    let canonical = BUNDLED
         .iter()
         .find(|(n, _)| *n == name)
-        .map(|(n, text)| Scenario::parse(text, &format!("scenarios/{n}.toml (bundled)")))
+        .map(|(n, text)| (format!("scenarios/{n}.toml"), *text));
+    let disturbed = || {
+        DISTURBED
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(n, text)| (format!("scenarios/disturbed/{n}.toml"), *text))
+    };
+    canonical
+        .or_else(disturbed)
+        .map(|(file, text)| Scenario::parse(text, &format!("{file} (bundled)")))
 }
 
 /// Loads `arg` as a file path if it names a file, else as a bundled scenario's name.

@@ -485,17 +485,20 @@ impl Reader<'_> {
             return self.fail(join(ctx, "at_s"), "must not be before start.time_s");
         }
         let kind = match self.string(e, ctx, "kind")?.as_str() {
-            "lead-route" => {
+            kind @ ("lead-route" | "lead-off-route") => {
                 self.only(e, ctx, &["at_s", "kind", "route_m", "speed_mps"])?;
                 if objective != Objective::MinTimeRendezvous {
                     return self.fail(
                         join(ctx, "kind"),
-                        "a lead-route event needs a min-time-rendezvous mission",
+                        format!("a {kind} event needs a min-time-rendezvous mission"),
                     );
                 }
-                EventKind::LeadRoute {
-                    route_m: self.polyline(e, ctx, "route_m", dim, MAX_ROUTE_POINTS)?,
-                    speed_mps: self.number(e, ctx, "speed_mps", Sign::Positive)?,
+                let route_m = self.polyline(e, ctx, "route_m", dim, MAX_ROUTE_POINTS)?;
+                let speed_mps = self.number(e, ctx, "speed_mps", Sign::Positive)?;
+                if kind == "lead-route" {
+                    EventKind::LeadRoute { route_m, speed_mps }
+                } else {
+                    EventKind::LeadOffRoute { route_m, speed_mps }
                 }
             }
             "targets" => {
@@ -537,7 +540,8 @@ impl Reader<'_> {
                 return self.fail(
                     join(ctx, "kind"),
                     format!(
-                        "unknown kind {other:?} (expected \"lead-route\", \"targets\" or \"final\")"
+                        "unknown kind {other:?} (expected \"lead-route\", \"lead-off-route\", \
+                         \"targets\" or \"final\")"
                     ),
                 );
             }

@@ -119,6 +119,12 @@ pub enum EventKind {
         route_m: Vec<[f64; 3]>,
         speed_mps: f64,
     },
+    /// The lead flies a new route from the event's time on without announcing it: no
+    /// route message, only its state shows it.
+    LeadOffRoute {
+        route_m: Vec<[f64; 3]>,
+        speed_mps: f64,
+    },
     /// A new list of remaining targets.
     Targets { targets_m: Vec<[f64; 3]> },
     /// A new final point.

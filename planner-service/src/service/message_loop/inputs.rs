@@ -9,10 +9,11 @@ use wingman_interfaces::{
     LeadRoute, LeadState, Message, Objective, OwnshipState, Tasking, ThreatReport, TrackFix,
     Trigger, ValidationError,
 };
+use wingman_planning::lead::LeadPath;
 
 use super::lifecycle::FirstPlan;
 use super::{MAX_CONTINUED_PLAN_ID, MessageLoop};
-use crate::service::triggers::{PopupAssessment, RouteDecision, TaskingDecision};
+use crate::service::triggers::{self, PopupAssessment, RouteDecision, TaskingDecision};
 use crate::service::world::{self, FixOutcome, Input, ThreatChange, ThreatSlot};
 
 /// Input problems the loop logs once, then only counts.
@@ -152,6 +153,44 @@ impl MessageLoop {
 
     fn on_lead_state(&mut self, s: &LeadState) {
         self.world.apply_lead_state(s);
+        self.check_lead_off_route(s);
+    }
+
+    /// A rendezvous whose lead, as `s` observes it, left the route the planner holds
+    /// (that revision) without a new one: the held route becomes the lead flying on as
+    /// observed, and the rendezvous is re-planned (`LeadOffRoute`).
+    fn check_lead_off_route(&mut self, s: &LeadState) {
+        let rendezvous = self
+            .world
+            .tasking
+            .as_ref()
+            .is_some_and(|t| t.objective() == Some(Objective::MinTimeRendezvous));
+        let Some(route) = self.world.route else {
+            return;
+        };
+        let meet_at_s = self.current.final_time_s;
+        if !rendezvous
+            || !self.has_plan
+            || s.route_revision != route.revision
+            || s.time_s >= meet_at_s
+        {
+            return;
+        }
+        let Ok(path) = LeadPath::new(route.points(), route.speed_mps, route.start_time_s) else {
+            return;
+        };
+        let off_m = triggers::lead_off_route_m(&path, s, meet_at_s);
+        if off_m <= self.cfg.triggers.lead_off_route_m {
+            return;
+        }
+        info!(
+            t = s.time_s,
+            off_m,
+            meet_at_s,
+            "the lead left its route: re-plan the rendezvous with the lead as observed"
+        );
+        self.world.route = Some(triggers::observed_route(s, route.revision));
+        self.raise(Trigger::LeadOffRoute);
     }
 
     fn on_ownship(&mut self, s: &OwnshipState) {

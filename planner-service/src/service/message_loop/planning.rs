@@ -232,6 +232,7 @@ impl MessageLoop {
         let bounds = DeviationBounds {
             cross_m: self.cfg.triggers.deviation_cross_m,
             vertical_m: self.cfg.triggers.deviation_vertical_m,
+            along_m: self.cfg.triggers.deviation_along_m,
         };
         if self.fired.deviation != id
             && let Some(o) = &self.world.ownship
@@ -241,6 +242,7 @@ impl MessageLoop {
             info!(
                 cross_m = o.cross_track_m,
                 vertical_m = o.vertical_m,
+                along_m = o.along_track_m,
                 "deviation from the plan"
             );
             self.raise(Trigger::Deviation);
