@@ -111,10 +111,10 @@ fn truth_problem(sc: &Scenario) -> PlotResult<Problem> {
     Problem::from_scenario(&all).map_err(boxed)
 }
 
-/// The lead's routes, each where the lead flew it: from its time to the next route's or
-/// the end.
+/// The lead's routes, each where the lead flew it (announced or not): from its time to
+/// the next route's or the end.
 fn lead_paths(flight: &Flight) -> Vec<MapPath> {
-    let routes = flight.datalink.routes();
+    let routes = flight.datalink.flown_routes();
     let mut paths = Vec::new();
     for (k, r) in routes.iter().enumerate() {
         let until = routes

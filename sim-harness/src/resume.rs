@@ -250,7 +250,7 @@ pub fn check_plan(
     let (goal, what) = match sc.objective {
         Objective::MinTimeRendezvous => {
             let lead = datalink
-                .route_at(planner_s)
+                .flown_route_at(planner_s)
                 .map(|r| r.path.at(plan.final_time_s).position)
                 .ok_or_else(|| mismatch("the rendezvous scenario has no lead route".into()))?;
             (lead, "the lead")

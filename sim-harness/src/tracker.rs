@@ -132,6 +132,11 @@ impl InnerLoop {
         self.t = t;
         self.state = x;
         self.control = u;
+        // The disturbances start again from their seeds; the aircraft flies the plan's
+        // control already.
+        if let Some(truth) = &mut self.truth {
+            truth.applying(u);
+        }
         self.receive(plan);
         self.update_deviation();
     }

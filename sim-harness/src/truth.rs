@@ -21,6 +21,11 @@ pub use wind::Wind;
 use wingman_planning::problem::Problem;
 use wingman_planning::scenario::{AircraftSpec, Scenario, WindSpec};
 
+/// The ChaCha8 streams of the gusts and of the navigation errors: two parts given the
+/// same seed (both default to 0) still draw independent numbers.
+const WIND_STREAM: u64 = 1;
+const NAVIGATION_STREAM: u64 = 2;
+
 /// The disturbances of one flight.
 #[derive(Debug, Clone)]
 pub struct Truth {
@@ -59,6 +64,11 @@ impl Truth {
     /// What the navigation solution says of the true state `x`.
     pub fn sense(&self, x: &[f64; 7]) -> [f64; 7] {
         self.navigation.sense(x)
+    }
+
+    /// The aircraft flying `control` already (a resumed flight taking over in the air).
+    pub fn applying(&mut self, control: [f64; 2]) {
+        self.autopilot.applying(control);
     }
 
     /// The control the aircraft applies over the next `h` seconds when commanded

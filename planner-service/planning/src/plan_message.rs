@@ -257,12 +257,13 @@ impl PlanPoints {
         self.spatial.clear();
     }
 
-    /// Fills the points from the plan's samples; velocities from the model at `speed`.
-    pub fn fill(&mut self, plan: &Plan, speed: f64) {
+    /// Fills the points from the plan's samples; velocities over the ground from the model
+    /// at `speed` in the steady `wind`.
+    pub fn fill(&mut self, plan: &Plan, speed: f64, wind: [f64; 3]) {
         self.clear();
         match plan.model() {
             Some(Model::TwoD) => {
-                let Ok(model) = Planar::new(speed) else {
+                let Ok(model) = Planar::new(speed).map(|m| m.with_wind(wind)) else {
                     return;
                 };
                 self.planar.extend(plan.samples().iter().map(|s| {
@@ -270,7 +271,7 @@ impl PlanPoints {
                 }));
             }
             Some(Model::ThreeD) => {
-                let Ok(model) = Spatial::new(speed) else {
+                let Ok(model) = Spatial::new(speed).map(|m| m.with_wind(wind)) else {
                     return;
                 };
                 self.spatial.extend(

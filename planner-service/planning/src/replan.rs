@@ -4,7 +4,7 @@
 //!
 //! Pure functions of a plan given as samples and a threat; no allocation, no clock.
 
-use crate::dynamics::{Planar, Spatial, State2, State3, idx2};
+use crate::dynamics::{OdeModel, Planar, Spatial, State2, State3};
 use crate::estimation::{MovingThreat, Region};
 use crate::threat::Superquadric;
 
@@ -20,13 +20,13 @@ pub struct PlanPoint<const D: usize> {
 }
 
 impl PlanPoint<2> {
-    /// The sample of a 2-D state.
+    /// The sample of a 2-D state: its velocity over the ground (the model's wind added).
     pub fn from_state2(model: &Planar, t: f64, x: &State2) -> Self {
-        let (s, c) = x[idx2::PSI].sin_cos();
+        let f = model.rhs(x, &[0.0]);
         Self {
             t,
             position: [x[0], x[1]],
-            velocity: [model.speed() * c, model.speed() * s],
+            velocity: [f[0], f[1]],
         }
     }
 }

@@ -63,6 +63,20 @@ impl Autopilot {
         self.applied
     }
 
+    /// The aircraft applying `control` already (clamped to its limits).
+    pub fn applying(&mut self, control: [f64; 2]) {
+        let channels = self.channels();
+        for ((applied, c), max) in self
+            .applied
+            .iter_mut()
+            .zip(control)
+            .zip(self.control_max)
+            .take(channels)
+        {
+            *applied = c.clamp(-max, max);
+        }
+    }
+
     /// Position components of the state: 2 in 2-D, 3 in 3-D.
     pub fn position_dim(&self) -> usize {
         self.model.position_dim()

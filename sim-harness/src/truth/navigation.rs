@@ -21,6 +21,8 @@ impl Navigation {
     /// The navigation errors of `spec` for a vehicle of `model`.
     pub fn new(spec: &AircraftSpec, model: Model) -> Navigation {
         let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
+        // Its own stream: the gusts of the same seed draw from another.
+        rng.set_stream(super::NAVIGATION_STREAM);
         let dim = model.position_dim();
         let errors = std::array::from_fn(|i| {
             let sigma = match i {

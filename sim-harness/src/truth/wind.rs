@@ -23,6 +23,8 @@ impl Wind {
     /// The wind of `spec` for a vehicle of `model` flying at `airspeed` m/s.
     pub fn new(spec: &WindSpec, model: Model, airspeed: f64) -> Wind {
         let mut rng = ChaCha8Rng::seed_from_u64(spec.seed);
+        // Its own stream: the navigation errors of the same seed draw from another.
+        rng.set_stream(super::WIND_STREAM);
         let tau = spec.gust_length_m / airspeed;
         let axes = model.position_dim();
         let gusts = std::array::from_fn(|i| {

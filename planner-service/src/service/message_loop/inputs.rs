@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use tracing::{error, info, warn};
 use wingman_interfaces::{
-    LeadRoute, LeadState, Message, Objective, OwnshipState, Tasking, ThreatReport, TrackFix,
+    LeadRoute, LeadState, Message, Model, Objective, OwnshipState, Tasking, ThreatReport, TrackFix,
     Trigger, ValidationError,
 };
 use wingman_planning::lead::LeadPath;
@@ -169,11 +169,9 @@ impl MessageLoop {
             return;
         };
         let meet_at_s = self.current.final_time_s;
-        if !rendezvous
-            || !self.has_plan
-            || s.route_revision != route.revision
-            || s.time_s >= meet_at_s
-        {
+        // A lead still waiting for its route's start is on it (LeadPath: at rest there).
+        let on_its_way = s.time_s >= route.start_time_s && s.time_s < meet_at_s;
+        if !rendezvous || !self.has_plan || s.route_revision != route.revision || !on_its_way {
             return;
         }
         let Ok(path) = LeadPath::new(route.points(), route.speed_mps, route.start_time_s) else {
@@ -189,7 +187,12 @@ impl MessageLoop {
             meet_at_s,
             "the lead left its route: re-plan the rendezvous with the lead as observed"
         );
-        self.world.route = Some(triggers::observed_route(s, route.revision));
+        let mut observed = *s;
+        if self.world.tasking.as_ref().and_then(Tasking::model) == Some(Model::TwoD) {
+            observed.gamma_rad = 0.0;
+            observed.position_m[2] = 0.0;
+        }
+        self.world.route = Some(triggers::observed_route(&observed, route.revision));
         self.raise(Trigger::LeadOffRoute);
     }
 

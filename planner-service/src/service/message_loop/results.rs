@@ -86,8 +86,13 @@ impl MessageLoop {
 
     /// Publishes a plan made by the solver and makes it current.
     fn accept(&mut self, o: &PlanOutcome, ticket: &Ticket, compute_ms: f64, cuts: &[Cut]) {
-        // The model and speed of the problem planned (the tasking may have changed since).
-        let Some((model, speed)) = self.problem.as_ref().map(|p| (p.model, p.limits.speed)) else {
+        // The model, speed and wind of the problem planned (the tasking may have changed
+        // since).
+        let Some((model, speed, wind)) = self
+            .problem
+            .as_ref()
+            .map(|p| (p.model, p.limits.speed, p.wind))
+        else {
             error!(
                 trigger = ticket.trigger.name(),
                 "the problem buffers are missing: the plan made is dropped"
@@ -124,7 +129,7 @@ impl MessageLoop {
         // The known static threats the plan in flight enters, before it is replaced.
         let entered_before = self.has_plan.then(|| self.static_threats_entered());
         // Scheduled re-plans of the moving threats over the new plan.
-        self.points.fill(&self.scratch, speed);
+        self.points.fill(&self.scratch, speed, wind);
         std::mem::swap(&mut self.current, &mut self.scratch);
         self.has_plan = true;
         let slots: [Option<usize>; world::MAX_MOVING_THREATS] = {
