@@ -37,12 +37,13 @@ pub mod sensor;
 pub mod tracker;
 pub mod truth;
 
-use wingman_planning::scenario::{BUNDLED, Scenario, ScenarioError, bundled};
+use wingman_planning::scenario::{BUNDLED, DISTURBED, Scenario, ScenarioError, bundled};
 
 /// One line per bundled scenario: name, then its summary.
 pub fn list_bundled() -> Result<Vec<(String, String)>, ScenarioError> {
     BUNDLED
         .iter()
+        .chain(DISTURBED)
         .filter_map(|(name, _)| bundled(name))
         .map(|sc| {
             let sc: Scenario = sc?;

@@ -176,8 +176,11 @@ fn a_ci_sized_campaign_meets_its_bars_and_four_merged_shards_give_its_outcomes()
             assert!(same_flight(fa, fb), "{}:\n{fa:?}\n{fb:?}", a.name);
         }
     }
+    // Since the waves (decision 0040) the clock gates a take-off's wave: on this 2-core
+    // machine 7-12 of the 30 flights carry no cut at all, depending on its speed. A
+    // deterministic wave gate (docs/CAMPAIGN.md, left to do) would compare more.
     assert!(
-        compared >= COUNT / 3,
+        compared >= COUNT / 6,
         "only {compared} flights without a deadline cut"
     );
     // Merging a shard twice is refused.

@@ -4,25 +4,29 @@ use std::process::Command;
 use wingman_testkit::{binary, scenarios_dir};
 
 #[test]
-fn harness_lists_every_bundled_scenario() {
+fn harness_lists_every_bundled_scenario_canonical_and_disturbed() {
     let out = Command::new(binary("wingman-harness"))
         .arg("list")
         .output()
         .unwrap();
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
-    let files = std::fs::read_dir(scenarios_dir())
-        .unwrap()
-        .filter(|e| {
-            e.as_ref()
-                .unwrap()
-                .path()
-                .extension()
-                .is_some_and(|x| x == "toml")
-        })
-        .count();
+    let tomls = |dir: std::path::PathBuf| {
+        std::fs::read_dir(dir)
+            .unwrap()
+            .filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .path()
+                    .extension()
+                    .is_some_and(|x| x == "toml")
+            })
+            .count()
+    };
+    let files = tomls(scenarios_dir()) + tomls(scenarios_dir().join("disturbed"));
     assert_eq!(text.lines().count(), files);
     assert!(text.lines().any(|l| l.starts_with("3d-replan-popups ")));
+    assert!(text.lines().any(|l| l.starts_with("2d-fixed-time-windy ")));
 }
 
 #[test]
