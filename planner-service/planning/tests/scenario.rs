@@ -462,6 +462,13 @@ fn the_disturbed_scenarios_are_bundled_and_load() {
         assert_eq!(&file, text, "{name}");
         let sc = bundled(name).unwrap().unwrap();
         assert_eq!(sc.name, *name);
+        // Each threat keeps its own name (reports and logs name threats by it).
+        let threat_names = sc.threats.iter().map(|t| &t.name);
+        let moving_names = sc.moving_threats.iter().map(|m| &m.name);
+        assert!(
+            threat_names.chain(moving_names).all(|n| n != *name),
+            "{name}"
+        );
     }
     let windy = bundled("2d-fixed-time-windy").unwrap().unwrap();
     assert!(windy.wind.is_some() && windy.objective == Objective::FixedTime);
