@@ -248,7 +248,7 @@ fn a_lead_off_its_route_fires_beyond_the_bound_at_the_meeting_time() {
     // The re-plan meets the lead as observed: that route puts it where it is, going on
     // as it goes, so the same state is on it.
     let s = observed([15000.0, 300.0, 0.0], 20.0, 160.0);
-    let o = observed_route(&s, 1);
+    let o = observed_route(&s, 1, Model::TwoD);
     assert_eq!((o.revision, o.start_time_s, o.speed_mps), (1, 100.0, 160.0));
     let flown =
         wingman_planning::lead::LeadPath::new(o.points(), o.speed_mps, o.start_time_s).unwrap();

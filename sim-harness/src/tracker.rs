@@ -326,9 +326,7 @@ impl InnerLoop {
                 self.state = rk4_step_with(&m, t0, &self.state, h, &mut |_, _| applied);
             }
         }
-        if let Some(truth) = &self.truth {
-            truth.drift(&mut self.state, wind, h);
-        }
+        truth.drift(&mut self.state, wind, h);
         self.control = applied;
         self.t = t0 + h;
     }

@@ -29,6 +29,7 @@ const NAVIGATION_STREAM: u64 = 2;
 /// The disturbances of one flight.
 #[derive(Debug, Clone)]
 pub struct Truth {
+    model: wingman_interfaces::Model,
     wind: Wind,
     autopilot: Autopilot,
     navigation: Navigation,
@@ -40,16 +41,12 @@ impl Truth {
         if sc.wind.is_none() && sc.aircraft.is_none() {
             return None;
         }
-        let still = WindSpec {
-            mean_mps: [0.0; 3],
-            gust_sigma_mps: 0.0,
-            gust_length_m: wingman_planning::scenario::GUST_LENGTH_M,
-            seed: 0,
-        };
+        let still = WindSpec::still();
         let wind = sc.wind.as_ref().unwrap_or(&still);
         let ideal = AircraftSpec::ideal(&sc.vehicle);
         let aircraft = sc.aircraft.as_ref().unwrap_or(&ideal);
         Some(Truth {
+            model: problem.model,
             wind: Wind::new(wind, problem.model, problem.limits.speed),
             autopilot: Autopilot::new(aircraft, problem.model, problem.limits),
             navigation: Navigation::new(aircraft, problem.model),
@@ -86,7 +83,7 @@ impl Truth {
     /// The state after `h` seconds of flight: `x` moved by the wind over the ground,
     /// its load factor and bank kept within the airframe's limits (3-D).
     pub fn drift(&self, x: &mut [f64; 7], wind: [f64; 3], h: f64) {
-        for (p, w) in x.iter_mut().zip(wind).take(self.autopilot.position_dim()) {
+        for (p, w) in x.iter_mut().zip(wind).take(self.model.position_dim()) {
             *p += w * h;
         }
         self.autopilot.saturate(x);
@@ -122,9 +119,7 @@ mod tests {
         let w = [12.0, -7.0, 0.0];
         sc.wind = Some(WindSpec {
             mean_mps: w,
-            gust_sigma_mps: 0.0,
-            gust_length_m: 533.4,
-            seed: 3,
+            ..WindSpec::still()
         });
         let windy = fly(Truth::of(&sc, &problem));
         for i in 0..2 {
@@ -145,9 +140,7 @@ mod tests {
         });
         sc.wind = Some(WindSpec {
             mean_mps: [5.0, 0.0, 0.0],
-            gust_sigma_mps: 0.0,
-            gust_length_m: 533.4,
-            seed: 0,
+            ..WindSpec::still()
         });
         let truth = Truth::of(&sc, &problem).unwrap();
         let mut tracker = InnerLoop::new(&problem, TrackingGains::default())

@@ -21,7 +21,9 @@
 //! - a plan made short of `Optimal` (its deadline cut the NLP), refined once with a
 //!   longer budget ([`refine_due`]).
 
-use wingman_interfaces::{LeadRoute, LeadState, OwnshipState, Quality, Tasking, Trigger, Wire};
+use wingman_interfaces::{
+    LeadRoute, LeadState, Model, OwnshipState, Quality, Tasking, Trigger, Wire,
+};
 
 use wingman_planning::lead::LeadPath;
 
@@ -111,10 +113,15 @@ pub fn lead_off_route_m(route: &LeadPath, s: &LeadState, meet_at_s: f64) -> f64 
 
 /// The route the lead flies as observed in `s`: straight on from its position at its
 /// heading, flight-path angle and speed, from `s.time_s` (`revision` kept: the route it
-/// stands for), long enough for any mission.
-pub fn observed_route(s: &LeadState, revision: u32) -> LeadRoute {
+/// stands for), long enough for any mission; level at `z = 0` in 2-D.
+pub fn observed_route(s: &LeadState, revision: u32, model: Model) -> LeadRoute {
     const AHEAD_M: f64 = 2.0e6;
-    let v = lead_velocity(s);
+    let mut s = *s;
+    if model == Model::TwoD {
+        s.gamma_rad = 0.0;
+        s.position_m[2] = 0.0;
+    }
+    let v = lead_velocity(&s);
     let speed = s.speed_mps.max(f64::MIN_POSITIVE);
     let mut r = LeadRoute::zeroed();
     r.revision = revision;

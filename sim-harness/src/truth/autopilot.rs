@@ -48,14 +48,7 @@ impl Autopilot {
             0.0
         };
         let most_change = self.turn_accel_max * h;
-        let channels = self.channels();
-        for ((applied, command), max) in self
-            .applied
-            .iter_mut()
-            .zip(command)
-            .zip(self.control_max)
-            .take(channels)
-        {
+        for ((applied, max), command) in self.channels_mut().zip(command) {
             let lagged = command + (*applied - command) * keep;
             let change = (lagged - *applied).clamp(-most_change, most_change);
             *applied = (*applied + change).clamp(-max, max);
@@ -65,21 +58,9 @@ impl Autopilot {
 
     /// The aircraft applying `control` already (clamped to its limits).
     pub fn applying(&mut self, control: [f64; 2]) {
-        let channels = self.channels();
-        for ((applied, c), max) in self
-            .applied
-            .iter_mut()
-            .zip(control)
-            .zip(self.control_max)
-            .take(channels)
-        {
+        for ((applied, max), c) in self.channels_mut().zip(control) {
             *applied = c.clamp(-max, max);
         }
-    }
-
-    /// Position components of the state: 2 in 2-D, 3 in 3-D.
-    pub fn position_dim(&self) -> usize {
-        self.model.position_dim()
     }
 
     /// Keeps the load factor and the bank of a 3-D state within the airframe's limits.
@@ -91,11 +72,14 @@ impl Autopilot {
         }
     }
 
-    fn channels(&self) -> usize {
-        match self.model {
+    /// Each commanded channel's applied control and its bound (2-D: the turn rate; 3-D:
+    /// the rates of `Nz` and `mu`).
+    fn channels_mut(&mut self) -> impl Iterator<Item = (&mut f64, f64)> {
+        let channels = match self.model {
             Model::TwoD => 1,
             Model::ThreeD => 2,
-        }
+        };
+        self.applied.iter_mut().zip(self.control_max).take(channels)
     }
 }
 

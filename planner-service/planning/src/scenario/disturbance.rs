@@ -56,6 +56,18 @@ pub struct AircraftSpec {
     pub seed: u64,
 }
 
+impl WindSpec {
+    /// Still air.
+    pub fn still() -> WindSpec {
+        WindSpec {
+            mean_mps: [0.0; 3],
+            gust_sigma_mps: 0.0,
+            gust_length_m: GUST_LENGTH_M,
+            seed: 0,
+        }
+    }
+}
+
 impl AircraftSpec {
     /// The planner's model: an immediate response within the vehicle's limits, exact
     /// navigation.

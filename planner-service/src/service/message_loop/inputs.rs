@@ -187,12 +187,9 @@ impl MessageLoop {
             meet_at_s,
             "the lead left its route: re-plan the rendezvous with the lead as observed"
         );
-        let mut observed = *s;
-        if self.world.tasking.as_ref().and_then(Tasking::model) == Some(Model::TwoD) {
-            observed.gamma_rad = 0.0;
-            observed.position_m[2] = 0.0;
-        }
-        self.world.route = Some(triggers::observed_route(&observed, route.revision));
+        let model = self.world.tasking.as_ref().and_then(Tasking::model);
+        let observed = triggers::observed_route(s, route.revision, model.unwrap_or(Model::ThreeD));
+        self.world.route = Some(observed);
         self.raise(Trigger::LeadOffRoute);
     }
 
