@@ -12,7 +12,16 @@
 //! plan is checked to carry no cut. A third flight, on the deployment defaults (re-plans
 //! within 300 ms in 3-D, so each re-plan also starts earlier: a plan commits at its start
 //! plus its budget), is then held to issue 31's yardstick: every plan `Optimal`, the end
-//! within 1 % and the rendezvous within 10 m of the uncut flight.
+//! within 1 % of the uncut flight, each re-plan's cost within 0.1 % of the uncut flight's
+//! plan for the same event, and the rendezvous within 20 m of the uncut flight's.
+//!
+//! Why 20 m (issue 31 set 10 m, measured at 5 m then). The pop-up re-plan's warm solve
+//! takes 170-220 ms of its 300 ms budget on a 2-core VM; whether its mesh-refinement round
+//! (about 50 ms) still fits decides between two `Optimal` plans 0.009 % apart in cost, and
+//! the flights that follow meet the lead 6.7 m or 15.6 m from the uncut flight's rendezvous
+//! (quiet runs on one machine gave either, about half each; a clean-clone CI run gave
+//! 15.6 m). The degraded plans issue 31 replaced (`SwarmOnly`, 14 % costlier) met the lead
+//! 27-95 m away and 80 s later: the cost check and 20 m still tell those apart.
 
 use std::path::Path;
 use std::time::Duration;
@@ -90,8 +99,16 @@ fn the_same_mission_flown_twice_gives_identical_plans() {
     let uncut = &reports[0];
     let plans = defaults["plans"].as_array().unwrap();
     assert_eq!(plans.len(), runs[0].len(), "the same events re-plan");
-    for p in plans {
+    let uncut_plans = uncut["plans"].as_array().unwrap();
+    for (p, q) in plans.iter().zip(uncut_plans) {
         assert_eq!(p["quality"], "Optimal", "{p}");
+        assert_eq!(p["trigger"], q["trigger"], "the same events in the same order");
+        let (c, c_uncut) = (p["cost"].as_f64().unwrap(), q["cost"].as_f64().unwrap());
+        assert!(
+            (c - c_uncut).abs() <= 1e-3 * c_uncut,
+            "plan {} costs {c}, the uncut flight's {c_uncut}",
+            p["plan_id"]
+        );
     }
     let end = |r: &serde_json::Value| r["end_s"].as_f64().unwrap();
     let (t_default, t_uncut) = (end(&defaults), end(uncut));
@@ -114,7 +131,7 @@ fn the_same_mission_flown_twice_gives_identical_plans() {
         .sum::<f64>()
         .sqrt();
     assert!(
-        apart <= 10.0,
+        apart <= 20.0,
         "the rendezvous is {apart} m from the uncut flight's"
     );
 }
