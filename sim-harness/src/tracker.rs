@@ -7,7 +7,8 @@
 //! no plan), logging each hold.
 //!
 //! With a truth model ([`crate::truth`]: the scenario's `[wind]` and `[aircraft]`) the
-//! tracker commands from the navigation solution, the aircraft answers with its own lag
+//! tracker commands from the navigation solution against the plan's point abeam the
+//! aircraft ([`abeam`]: it follows the path), the aircraft answers with its own lag
 //! and limits (held over each step), the wind carries it over the ground, and
 //! `OwnshipState` reports the navigation solution; the samples keep the true state.
 
@@ -332,11 +333,11 @@ impl InnerLoop {
     }
 
     /// The tracker's command at `t` for the state `x` it sees: the tracking law on the
-    /// flown plan, or the safe hold.
+    /// flown plan's point abeam `x`, or the safe hold.
     fn command(&self, t: f64, x: &[f64; 7]) -> [f64; 2] {
         match (self.flying(), self.holding()) {
             (Some(p), false) => {
-                let (xr, ur) = reference(&p.plan, t);
+                let (xr, ur) = abeam(&p.plan, &self.tracker, t, x, self.limits.speed);
                 self.tracker.control(x, &xr, &ur)
             }
             _ => hold_control(self.model, &self.limits, x),
@@ -412,6 +413,28 @@ pub fn reference(plan: &Plan, t: f64) -> ([f64; 7], [f64; 2]) {
         std::array::from_fn(|i| a.state[i] + f * (b.state[i] - a.state[i])),
         std::array::from_fn(|i| a.control[i] + f * (b.control[i] - a.control[i])),
     )
+}
+
+/// The plan's state and control abeam `x` (at plan time near `t`): the point at time `t`
+/// moved along the plan by `x`'s along-track deviation from it, twice over. The tracker of
+/// a disturbed flight follows the path: an aircraft the gusts have put ahead of or behind
+/// its plan flies the plan's path on, rather than a short cut across a turn towards where
+/// the plan is now (at constant airspeed it cannot make up time, and a cut turn misses the
+/// target on it); the along-track deviation is the planner's to re-plan.
+pub fn abeam(
+    plan: &Plan,
+    tracker: &Tracker,
+    t: f64,
+    x: &[f64; 7],
+    speed: f64,
+) -> ([f64; 7], [f64; 2]) {
+    let mut at = t;
+    let mut point = reference(plan, at);
+    for _ in 0..2 {
+        at += tracker.deviation(x, &point.0).along_m / speed;
+        point = reference(plan, at);
+    }
+    point
 }
 
 /// The safe hold: a level turn to the left. 2-D: half the turn-rate limit. 3-D: bank

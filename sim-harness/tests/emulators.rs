@@ -6,7 +6,7 @@
 use wingman_harness::clock::{ClockMode, Pacer, Periodic, step_time};
 use wingman_harness::datalink::Datalink;
 use wingman_harness::sensor::{SensorOutput, ThreatSensor};
-use wingman_harness::tracker::{InnerLoop, ReceivedPlan};
+use wingman_harness::tracker::{InnerLoop, ReceivedPlan, abeam, reference};
 use wingman_interfaces::{
     Header, Model, OWNSHIP_HOLDING, Plan, Quality, SENDER_PLANNER, Trigger, Wire,
 };
@@ -14,7 +14,7 @@ use wingman_planning::dynamics::{Planar, rk4_step_with};
 use wingman_planning::plan_message::{PlanInfo, set_next_replan, write_plan};
 use wingman_planning::problem::Problem;
 use wingman_planning::scenario::{Scenario, bundled};
-use wingman_planning::tracking::TrackingGains;
+use wingman_planning::tracking::{Tracker, TrackingGains};
 use wingman_planning::trajectory::Trajectory;
 
 fn scenario(name: &str) -> Scenario {
@@ -114,6 +114,36 @@ fn the_tracker_follows_a_plan_and_recovers_from_an_offset() {
     assert_eq!(own.plan_id, 1);
     assert_eq!(own.flags & OWNSHIP_HOLDING, 0);
     assert_eq!(own.cross_track_m, last.cross_m);
+}
+
+/// The disturbed tracker's reference is the plan's point abeam the aircraft, not the point
+/// of the same time: an aircraft on the path `ahead` seconds ahead of (or behind) its plan,
+/// on the straight and in the turn, gets the plan's state at `t + ahead` (to 0.5 m; the
+/// plan is linear between 0.5 s samples), and one 60 m to the side of that point too.
+#[test]
+fn the_disturbed_tracker_follows_the_point_abeam() {
+    let problem = Problem::from_scenario(&scenario("2d-min-time-avoidable")).unwrap();
+    let plan = planar_plan(&problem, 1, 0.0, [0.0, 0.0, 0.3], 300.0);
+    let tracker = Tracker::new(&problem, TrackingGains::default());
+    let v = problem.limits.speed;
+    for (t, ahead) in [(50.0, 1.6), (50.0, -2.4), (140.0, 1.6), (160.0, -2.4)] {
+        let (want, _) = reference(&plan, t + ahead);
+        let psi = want[2];
+        for side in [0.0, 60.0] {
+            let mut x = want;
+            x[0] -= side * psi.sin();
+            x[1] += side * psi.cos();
+            let (got, _) = abeam(&plan, &tracker, t, &x, v);
+            let apart = (got[0] - want[0]).hypot(got[1] - want[1]);
+            assert!(apart < 0.5, "t {t} ahead {ahead} side {side}: {apart} m");
+        }
+        let (same_time, _) = reference(&plan, t);
+        let moved = (same_time[0] - want[0]).hypot(same_time[1] - want[1]);
+        assert!(
+            moved > 0.9 * ahead.abs() * v,
+            "the points differ: {moved} m"
+        );
+    }
 }
 
 #[test]

@@ -102,7 +102,10 @@ fn the_same_mission_flown_twice_gives_identical_plans() {
     let uncut_plans = uncut["plans"].as_array().unwrap();
     for (p, q) in plans.iter().zip(uncut_plans) {
         assert_eq!(p["quality"], "Optimal", "{p}");
-        assert_eq!(p["trigger"], q["trigger"], "the same events in the same order");
+        assert_eq!(
+            p["trigger"], q["trigger"],
+            "the same events in the same order"
+        );
         let (c, c_uncut) = (p["cost"].as_f64().unwrap(), q["cost"].as_f64().unwrap());
         assert!(
             (c - c_uncut).abs() <= 1e-3 * c_uncut,

@@ -194,7 +194,7 @@ impl Default for TriggerConfig {
             f_star: 1.0,
             deviation_cross_m: 500.0,
             deviation_vertical_m: 200.0,
-            deviation_along_m: 300.0,
+            deviation_along_m: 100.0,
             replan_min_lead_s: 1.0,
             first_plan_wait_ms: 300,
             refine: true,
