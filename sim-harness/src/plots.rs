@@ -16,6 +16,7 @@ use wingman_interfaces::{Model, Objective, Trigger};
 use wingman_planning::estimation::{GaussMarkov, MovingThreat, Road};
 use wingman_planning::problem::Problem;
 use wingman_planning::scenario::Scenario;
+use wingman_planning::tracking::Deviation;
 use wingman_plot::{self as plot, MapMarker, MapPath, MapPlot, Stroke};
 
 use crate::mission::Flight;
@@ -421,8 +422,8 @@ where
     legend(&mut c)
 }
 
-/// Panel 2: the tracker's deviation from the plan it flies (cross-track, and vertical in
-/// 3-D), with the holds shaded.
+/// Panel 2: the tracker's deviation from the plan it flies (cross-track, along-track, and
+/// vertical in 3-D), with the holds shaded.
 fn deviation_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     flight: &Flight,
@@ -435,7 +436,10 @@ where
     let d_max = flight
         .samples
         .iter()
-        .flat_map(|s| [s.deviation.cross_m.abs(), s.deviation.vertical_m.abs()])
+        .flat_map(|s| {
+            let d = s.deviation;
+            [d.cross_m.abs(), d.along_m.abs(), d.vertical_m.abs()]
+        })
         .fold(1.0, f64::max)
         * 1.15;
     let mut c = timeline_chart(
@@ -445,23 +449,26 @@ where
         -d_max..d_max,
         "deviation [m]",
     )?;
-    let blue = RGBColor(31, 119, 180);
-    c.draw_series(LineSeries::new(
-        flight.samples.iter().map(|s| (s.t, s.deviation.cross_m)),
-        blue.stroke_width(2),
-    ))
-    .map_err(boxed)?
-    .label("cross-track (left +)")
-    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], blue));
-    if three_d {
-        let green = RGBColor(44, 160, 44);
+    type Axis = fn(&Deviation) -> f64;
+    let axes: [(&str, RGBColor, u32, Axis); 3] = [
+        ("cross-track (left +)", RGBColor(31, 119, 180), 2, |d| {
+            d.cross_m
+        }),
+        ("along-track (ahead +)", RGBColor(110, 110, 110), 1, |d| {
+            d.along_m
+        }),
+        ("vertical (above +)", RGBColor(44, 160, 44), 2, |d| {
+            d.vertical_m
+        }),
+    ];
+    for (label, color, width, axis) in axes.into_iter().take(if three_d { 3 } else { 2 }) {
         c.draw_series(LineSeries::new(
-            flight.samples.iter().map(|s| (s.t, s.deviation.vertical_m)),
-            green.stroke_width(2),
+            flight.samples.iter().map(|s| (s.t, axis(&s.deviation))),
+            color.stroke_width(width),
         ))
         .map_err(boxed)?
-        .label("vertical (above +)")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], green));
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color));
     }
     let holds: Vec<(f64, f64)> = flight
         .holds
