@@ -6,7 +6,8 @@
 //! targets and threats, which features), the vehicle, the start, the targets, the final
 //! point or the lead (and its change of route), the defended threat of an unavoidable
 //! layout, the pop-ups (before the static threats fill the room near the legs), the
-//! static threats, the moving threats, then the final time.
+//! static threats, the moving threats, the final time, then the wind (drawn last, so that
+//! a mission without one is the same as before the wind was drawn).
 //! Well-posed means:
 //! - threats keep clear of the start, the targets and the end by two turn radii, and of
 //!   the lead's routes where a rendezvous may happen;
@@ -19,10 +20,11 @@
 //! - a moving threat's road keeps clear of the targets and the end;
 //! - a fixed final time leaves 10–30 % over the length of a path that avoids every threat
 //!   ([`super::layout::avoiding_length`]);
-//! - the lead is slower than the wingman.
+//! - the lead is slower than the wingman;
+//! - a wind is 3–8 % of the airspeed, and a fixed final time is sized at the airspeed
+//!   less the wind, so that a headwind still leaves the slack.
 
 use std::f64::consts::PI;
-use std::fmt::Write;
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -30,6 +32,8 @@ use rand_chacha::ChaCha8Rng;
 use wingman_planning::threat::MAX_THREATS;
 
 use super::kind::{Feature, Filter, MissionKind};
+
+mod scenario_file;
 use super::layout::{Footprint, along, avoiding_length, dist, segment_dist, xy};
 
 /// One drawn mission.
@@ -83,6 +87,7 @@ fn draw_once(seed: u64, index: usize, attempt: u64, filter: &Filter) -> Drawn {
     m.draw_threats(&mut rng);
     m.draw_moving(&mut rng);
     m.draw_final_time(&mut rng);
+    m.draw_wind(&mut rng, filter);
     let kind = m.kind();
     let name = format!(
         "c{seed}-{index:04}-{}-{}",
@@ -123,6 +128,19 @@ struct MovingThreat {
     truth_seed: u64,
 }
 
+/// The wind of a windy mission and the aircraft the harness flies in it.
+#[derive(Debug, Clone)]
+struct Wind {
+    mean: [f64; 2],
+    /// `"none"` or `"light"`.
+    gusts: &'static str,
+    seed: u32,
+    response_s: f64,
+    nav_sigma_m: f64,
+    nav_heading_sigma_deg: f64,
+    aircraft_seed: u32,
+}
+
 /// A mission as it is drawn.
 #[derive(Debug, Clone)]
 struct Mission {
@@ -142,12 +160,15 @@ struct Mission {
     /// Fixed-time and min-time: position and heading.
     final_point: Option<([f64; 3], f64)>,
     final_time: Option<f64>,
+    /// A fixed final time's length to fly: the avoiding path's, with its slack.
+    time_length: Option<f64>,
     lead_speed: f64,
     /// The lead's change of route: when, the new heading (rad) and speed.
     lead_turn: Option<(f64, f64, f64)>,
     threats: Vec<StaticThreat>,
     popups: Vec<StaticThreat>,
     moving: Vec<MovingThreat>,
+    wind: Option<Wind>,
 }
 
 impl Mission {
@@ -198,11 +219,13 @@ impl Mission {
             targets: Vec::new(),
             final_point: None,
             final_time: None,
+            time_length: None,
             lead_speed: 0.0,
             lead_turn: None,
             threats: Vec::new(),
             popups: Vec::new(),
             moving: Vec::new(),
+            wind: None,
         }
     }
 
@@ -493,7 +516,37 @@ impl Mission {
         }));
         let length = avoiding_length(&self.legs(), &discs, self.turn_radius);
         let slack: f64 = rng.random_range(1.1..1.3);
+        self.time_length = Some(slack * length);
         self.final_time = Some((slack * length / self.speed).round());
+    }
+
+    /// Three missions in ten fly in a wind of 3–8 % of the airspeed from any direction,
+    /// half of them with light gusts, with an aircraft that lags its commands by 0.3–0.8 s
+    /// and navigates with 5–15 m and 0.1–0.3° errors. A fixed final time is sized again at
+    /// the airspeed less the wind.
+    fn draw_wind(&mut self, rng: &mut ChaCha8Rng, filter: &Filter) {
+        if rng.random::<f64>() >= filter.chance(Feature::Wind, 0.3) {
+            return;
+        }
+        let speed = self.speed * rng.random_range(0.03..0.08);
+        let from = rng.random_range(0.0..2.0 * PI);
+        let wind = Wind {
+            mean: [speed * from.cos(), speed * from.sin()],
+            gusts: if rng.random::<bool>() {
+                "light"
+            } else {
+                "none"
+            },
+            seed: rng.random(),
+            response_s: rng.random_range(0.3..0.8),
+            nav_sigma_m: rng.random_range(5.0..15.0),
+            nav_heading_sigma_deg: rng.random_range(0.1..0.3),
+            aircraft_seed: rng.random(),
+        };
+        if let Some(length) = self.time_length {
+            self.final_time = Some((length / (self.speed - speed)).round());
+        }
+        self.wind = Some(wind);
     }
 
     /// What the mission came out as.
@@ -507,168 +560,9 @@ impl Mission {
             moving: self.moving.len(),
             unavoidable: self.unavoidable,
             lead_change: self.lead_turn.is_some(),
+            wind: self.wind.is_some(),
             // Placed first, it is `t0` (see `draw_defended`).
             defended: self.unavoidable.then(|| "t0".to_string()),
-        }
-    }
-
-    /// The scenario file.
-    fn to_toml(&self, name: &str, summary: &str) -> String {
-        let mut s = String::new();
-        let model = if self.three_d { "3d" } else { "2d" };
-        let _ = writeln!(
-            s,
-            "name = \"{name}\"\nsummary = \"{summary}\"\nmodel = \"{model}\"\nobjective = \"{}\"\n",
-            self.objective
-        );
-        self.write_vehicle(&mut s);
-        let _ = writeln!(
-            s,
-            "[start]\ntime_s = 0.0\nposition_m = {}\nheading_deg = {:.1}{}\n",
-            self.point(&self.start),
-            self.heading_deg,
-            if self.three_d {
-                "\ngamma_deg = 0.0"
-            } else {
-                ""
-            }
-        );
-        for t in &self.targets {
-            let _ = writeln!(s, "[[targets]]\nposition_m = {}\n", self.point(t));
-        }
-        self.write_end(&mut s);
-        for (k, t) in self.threats.iter().enumerate() {
-            self.write_static(&mut s, &format!("t{k}"), t);
-        }
-        for (k, t) in self.popups.iter().enumerate() {
-            self.write_static(&mut s, &format!("popup-{k}"), t);
-        }
-        for (k, m) in self.moving.iter().enumerate() {
-            self.write_moving(&mut s, k, m);
-        }
-        if let Some((at, turn, speed)) = self.lead_turn {
-            let from = [self.lead_speed * at, 0.0, self.start[2]];
-            let to = [
-                from[0] + 400_000.0 * turn.cos(),
-                400_000.0 * turn.sin(),
-                self.start[2],
-            ];
-            let _ = writeln!(
-                s,
-                "[[events]]\nat_s = {at:.1}\nkind = \"lead-route\"\nroute_m = [{}, {}]\nspeed_mps = {speed:.1}\n",
-                self.point(&from),
-                self.point(&to)
-            );
-        }
-        s
-    }
-
-    fn write_vehicle(&self, s: &mut String) {
-        if self.three_d {
-            let _ = writeln!(
-                s,
-                "[vehicle]\nspeed_mps = {:.1}\ngamma_max_deg = 30.0\nnz_min = -1.0\nnz_max = 4.0\nbank_max_deg = 70.0\nnz_rate_max_per_s = 1.0\nbank_rate_max_dps = 30.0\naltitude_min_m = 500.0\n",
-                self.speed
-            );
-        } else {
-            let _ = writeln!(
-                s,
-                "[vehicle]\nspeed_mps = {:.1}\nturn_rate_max_dps = 5.0\n",
-                self.speed
-            );
-        }
-        let _ = writeln!(
-            s,
-            "[weights]\nalpha = 0.05\nbeta = 0.95\nstiffness = 30.0\n"
-        );
-    }
-
-    /// `[final]` or `[lead]`.
-    fn write_end(&self, s: &mut String) {
-        if let Some((f, heading)) = &self.final_point {
-            let _ = write!(
-                s,
-                "[final]\nposition_m = {}\nheading_deg = {heading:.1}\n",
-                self.point(f)
-            );
-            if self.three_d {
-                let _ = writeln!(s, "gamma_deg = 0.0");
-            }
-            if let Some(t) = self.final_time {
-                let _ = writeln!(s, "time_s = {t:.1}");
-            }
-            let _ = writeln!(s);
-        } else {
-            let end = [400_000.0, 0.0, self.start[2]];
-            let _ = writeln!(
-                s,
-                "[lead]\nroute_m = [{}, {}]\nspeed_mps = {:.1}\n",
-                self.point(&self.start),
-                self.point(&end),
-                self.lead_speed
-            );
-        }
-    }
-
-    fn write_static(&self, s: &mut String, name: &str, t: &StaticThreat) {
-        let fp = &t.footprint;
-        let _ = writeln!(s, "[[threats]]\nname = \"{name}\"");
-        if self.three_d {
-            let _ = writeln!(
-                s,
-                "center_m = [{:.1}, {:.1}, 0.0]\naxes_m = [{:.1}, {:.1}, {:.1}]\nexponents = [{:.1}, {:.1}, 2.0]",
-                fp.center[0],
-                fp.center[1],
-                fp.axes[0],
-                fp.axes[1],
-                t.height,
-                fp.exponent,
-                fp.exponent
-            );
-        } else {
-            let _ = writeln!(
-                s,
-                "center_m = [{:.1}, {:.1}]\naxes_m = [{:.1}, {:.1}]\nexponents = [{:.1}, {:.1}]",
-                fp.center[0], fp.center[1], fp.axes[0], fp.axes[1], fp.exponent, fp.exponent
-            );
-        }
-        let _ = writeln!(s, "yaw_deg = {:.1}", fp.yaw_deg);
-        if let Some(at) = t.appears_at_s {
-            let _ = writeln!(s, "appears_at_s = {at:.1}");
-        }
-        let _ = writeln!(s);
-    }
-
-    fn write_moving(&self, s: &mut String, k: usize, m: &MovingThreat) {
-        let road: Vec<String> = m
-            .road
-            .iter()
-            .map(|p| self.point(&[p[0], p[1], 0.0]))
-            .collect();
-        let axes = if self.three_d {
-            format!("[{:.1}, {:.1}, {:.1}]", m.axes[0], m.axes[1], m.axes[2])
-        } else {
-            format!("[{:.1}, {:.1}]", m.axes[0], m.axes[1])
-        };
-        let _ = writeln!(
-            s,
-            "[[moving_threats]]\nname = \"mobile-{k}\"\nroad_m = [{}]\naxes_m = {axes}\ninitial_distance_m = {:.1}\ninitial_speed_mps = {:.1}\naccel_sigma_mps2 = {:.2}\naccel_tau_s = 60.0\ninitial_sigma = [500.0, 3.0, 0.3]\nappears_at_s = {:.1}\n[moving_threats.sensor]\nrate_hz = 1.0\nsigma_m = {:.1}\n[moving_threats.truth]\nseed = {}\n",
-            road.join(", "),
-            m.initial_distance,
-            m.initial_speed,
-            m.accel_sigma,
-            m.appears_at_s,
-            m.sensor_sigma,
-            m.truth_seed
-        );
-    }
-
-    /// A point as a TOML array (2 or 3 coordinates), to 0.1 m.
-    fn point(&self, p: &[f64; 3]) -> String {
-        if self.three_d {
-            format!("[{:.1}, {:.1}, {:.1}]", p[0], p[1], p[2])
-        } else {
-            format!("[{:.1}, {:.1}]", p[0], p[1])
         }
     }
 }
@@ -696,6 +590,59 @@ mod tests {
             assert_eq!(sc.targets.len(), d.kind.targets);
             assert_eq!(draw(7, index, &Filter::default()).text, d.text);
         }
+    }
+
+    /// The wind is drawn last: a mission drawn without one is the mission drawn before the
+    /// wind existed, and a windy one is that mission with its `[wind]` and `[aircraft]`
+    /// tables added (a fixed final time sized at the airspeed less the wind instead).
+    #[test]
+    fn a_wind_is_added_to_the_mission_drawn_without_it() {
+        let still_air = Filter {
+            without: vec![Feature::Wind],
+            ..Filter::default()
+        };
+        let mut windy = 0;
+        for index in 0..200 {
+            let d = draw(5, index, &Filter::default());
+            let e = draw(5, index, &still_air);
+            assert!(!e.kind.wind && !e.text.contains("[wind]"));
+            // The summary line names the wind.
+            let body = |t: &str| -> String {
+                t.lines()
+                    .filter(|l| !l.starts_with("summary = "))
+                    .map(|l| format!("{l}\n"))
+                    .collect()
+            };
+            let (d_body, e_body) = (body(&d.text), body(&e.text));
+            if !d.kind.wind {
+                assert_eq!(d.text, e.text, "{index}");
+                continue;
+            }
+            windy += 1;
+            let sc = Scenario::parse(&d.text, &d.name).unwrap();
+            let w = sc.wind.as_ref().expect("a [wind] table").mean_mps;
+            let speed = sc.vehicle.speed_mps;
+            let ratio = w[0].hypot(w[1]) / speed;
+            assert!((0.03..0.08).contains(&ratio), "{index}: {ratio}");
+            assert!(sc.aircraft.as_ref().is_some_and(|a| a.response_s > 0.0));
+            let still = Scenario::parse(&e.text, &e.name).unwrap();
+            let time = |sc: &Scenario| sc.final_point.as_ref().and_then(|f| f.time_s);
+            match (time(&sc), time(&still)) {
+                (Some(t), Some(t_still)) => {
+                    // Both rounded to 1 s.
+                    let want = t_still / (1.0 - ratio);
+                    assert!(
+                        (t - want).abs() <= 1.0 + 1e-9,
+                        "{index}: {t} against {want}"
+                    );
+                    // Up to the final time.
+                    let head = &d_body[..d_body.rfind("\ntime_s = ").unwrap()];
+                    assert!(e_body.starts_with(head), "{index}");
+                }
+                _ => assert!(d_body.starts_with(&e_body), "{index}"),
+            }
+        }
+        assert!((40..=80).contains(&windy), "{windy} windy of 200");
     }
 
     #[test]

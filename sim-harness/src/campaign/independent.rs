@@ -22,6 +22,7 @@ use serde::{Deserialize, Serialize};
 use wingman_interfaces::{Model, Plan};
 use wingman_planning::trajectory::Trajectory;
 
+use super::kind::MissionKind;
 use super::outcome::{COST_FLOOR, GAP_TOL, MissionOutcome, finite};
 use super::run::CampaignResults;
 
@@ -42,9 +43,11 @@ pub struct IndependentNumbers {
     pub compute_s: f64,
 }
 
-/// Whether mission `index` is one the independent solver plans (`every` 0: none).
-pub fn selected(index: usize, every: usize) -> bool {
-    every > 0 && index.is_multiple_of(every)
+/// Whether mission `index` (of `kind`) is one the independent solver plans (`every` 0:
+/// none). The solver and the customer's judge that judges it model still air: a windy
+/// mission is left out.
+pub fn selected(index: usize, kind: &MissionKind, every: usize) -> bool {
+    every > 0 && index.is_multiple_of(every) && !kind.wind
 }
 
 /// A path in the judge's `plan.json` layout (the keys the solver reads).
@@ -212,7 +215,7 @@ pub fn write_section(s: &mut String, r: &CampaignResults) {
     let picked: Vec<&MissionOutcome> = r
         .outcomes
         .iter()
-        .filter(|o| selected(o.index, every))
+        .filter(|o| selected(o.index, &o.kind, every))
         .collect();
     let beaten = picked
         .iter()
@@ -220,7 +223,7 @@ pub fn write_section(s: &mut String, r: &CampaignResults) {
         .count();
     let _ = writeln!(
         s,
-        "The take-off of every mission whose index is a multiple of {every} \
+        "The take-off of every mission in still air whose index is a multiple of {every} \
          (`tools/yardstick/ipopt_multistart.py` by default: Hermite–Simpson in CasADi, IPOPT \
          with exact Hessians, judged by the customer's judge; started from its own paths, \
          the default plan and the yardstick's). Gaps as the yardstick's, against its best \
@@ -288,6 +291,13 @@ mod tests {
         let none = r#"{"scenario": "m", "starts": [{"status": "error: x", "start": "bulge 0"}], "best": null}"#;
         assert!(parse_output(none).unwrap_err().contains("no start of 1"));
         assert!(parse_output("Traceback").is_err());
-        assert!(selected(0, 10) && selected(20, 10) && !selected(5, 10) && !selected(0, 0));
+        let still = super::super::generate::draw(3, 0, &Default::default()).kind;
+        let windy = MissionKind {
+            wind: true,
+            ..still.clone()
+        };
+        assert!(selected(0, &still, 10) && selected(20, &still, 10));
+        assert!(!selected(5, &still, 10) && !selected(0, &still, 0));
+        assert!(!selected(0, &windy, 10), "the solver is still air");
     }
 }

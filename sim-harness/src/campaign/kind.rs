@@ -20,15 +20,19 @@ pub enum Feature {
     Popups,
     /// The lead changes its route in flight (rendezvous missions only).
     LeadChange,
+    /// A steady wind, with light gusts or none, and an aircraft that lags its commands
+    /// and navigates with errors (the harness's truth model).
+    Wind,
 }
 
 impl Feature {
     /// Every feature, in the order of the report's tables.
-    pub const ALL: [Feature; 4] = [
+    pub const ALL: [Feature; 5] = [
         Feature::Unavoidable,
         Feature::Moving,
         Feature::Popups,
         Feature::LeadChange,
+        Feature::Wind,
     ];
 
     /// The name used on the command line and in the results.
@@ -38,6 +42,7 @@ impl Feature {
             Feature::Moving => "moving",
             Feature::Popups => "popups",
             Feature::LeadChange => "lead-change",
+            Feature::Wind => "wind",
         }
     }
 
@@ -65,6 +70,9 @@ pub struct MissionKind {
     pub moving: usize,
     pub unavoidable: bool,
     pub lead_change: bool,
+    /// Flown in a wind (told to the planner) by the harness's truth model.
+    #[serde(default)]
+    pub wind: bool,
     /// The defended threat an unavoidable layout's target sits in (the one threat its
     /// flight may enter).
     #[serde(default)]
@@ -79,6 +87,7 @@ impl MissionKind {
             Feature::Moving => self.moving > 0,
             Feature::Popups => self.popups > 0,
             Feature::LeadChange => self.lead_change,
+            Feature::Wind => self.wind,
         }
     }
 
@@ -104,6 +113,9 @@ impl MissionKind {
         }
         if self.lead_change {
             s.push_str(", lead changes route");
+        }
+        if self.wind {
+            s.push_str(", wind");
         }
         s
     }
@@ -227,5 +239,6 @@ mod tests {
         assert!(f.validate().unwrap_err().contains("both"));
         assert!(Feature::parse("pop-ups").is_err());
         assert_eq!(Feature::parse("popups"), Ok(Feature::Popups));
+        assert_eq!(Feature::parse("wind"), Ok(Feature::Wind));
     }
 }

@@ -247,6 +247,7 @@ mod tests {
             moving: 0,
             unavoidable,
             lead_change: false,
+            wind: false,
             defended: unavoidable.then(|| "t0".to_string()),
         }
     }

@@ -291,16 +291,17 @@ fn fly_and_judge(
         .yardstick
         .as_ref()
         .map(|spec| yardstick(&scenario, spec, clock).map_err(|e| format!("{e:#}")));
-    let independent = independent::selected(drawn.index, opts.spec.independent_every).then(|| {
-        let yardstick_plan = yardstick.as_ref().and_then(|y| y.as_ref().ok());
-        independent(
-            opts,
-            &scenario,
-            &file,
-            &flight,
-            yardstick_plan.map(|(_, tr)| tr),
-        )
-    });
+    let independent = independent::selected(drawn.index, &drawn.kind, opts.spec.independent_every)
+        .then(|| {
+            let yardstick_plan = yardstick.as_ref().and_then(|y| y.as_ref().ok());
+            independent(
+                opts,
+                &scenario,
+                &file,
+                &flight,
+                yardstick_plan.map(|(_, tr)| tr),
+            )
+        });
     Ok(Judged {
         flight: numbers,
         yardstick: yardstick.map(|y| y.map(|(numbers, _)| numbers)),

@@ -509,7 +509,7 @@ pub fn summary_json(r: &CampaignResults) -> serde_json::Value {
         "outlying": r.outcomes.iter().filter(|o| o.gap().is_some_and(|g| g > GAP_TOL)).map(|o| json!({
             "name": o.name, "gap": o.gap(), "kept": o.kept,
         })).collect::<Vec<_>>(),
-        "independent": r.outcomes.iter().filter(|o| independent::selected(o.index, r.spec.independent_every)).map(|o| json!({
+        "independent": r.outcomes.iter().filter(|o| independent::selected(o.index, &o.kind, r.spec.independent_every)).map(|o| json!({
             "name": o.name,
             "cost": o.independent.as_ref().map(|i| i.cost),
             "start": o.independent.as_ref().map(|i| &i.start),
