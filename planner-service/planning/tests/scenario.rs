@@ -473,7 +473,7 @@ fn the_disturbed_scenarios_are_bundled_and_load() {
     let windy = bundled("2d-fixed-time-windy").unwrap().unwrap();
     assert!(windy.wind.is_some() && windy.objective == Objective::FixedTime);
     let rough = bundled("3d-rendezvous-turbulence").unwrap().unwrap();
-    assert!(rough.wind.unwrap().gust_sigma_mps == 1.5 && rough.aircraft.is_some());
+    assert!(rough.wind.unwrap().gust_sigma_mps == 3.0 && rough.aircraft.is_some());
     let off = bundled("2d-rendezvous-lead-off-route").unwrap().unwrap();
     assert!(
         off.events
