@@ -432,6 +432,41 @@ pub fn phase_durations(t0: f64, tr: &Trajectory) -> Vec<f64> {
         .collect()
 }
 
+/// Farthest the exported plan's end may lie from where its problem wants it (the final
+/// point, or the lead at the plan's final time) for the plan to keep its NLP solution's
+/// `Optimal`, m. The NLP meets its end to its tolerance, but a 3-D plan is exported as its
+/// path flown by the tracking law, and a path the working mesh resolves too coarsely (its
+/// refinement round cut by the deadline) can be flown hundreds of metres off: a 3-D
+/// rendezvous re-planned for a lead's new route ended 743 m from the lead. Exports of
+/// converged plans end within a few metres.
+pub const EXPORT_END_TOL_M: f64 = 50.0;
+
+/// How far the end of `tr` lies from where `problem` wants it, m.
+pub fn end_miss_m(problem: &Problem, tr: &Trajectory) -> f64 {
+    let (Some(&t), Some(state)) = (tr.times.last(), tr.states.last()) else {
+        return f64::INFINITY;
+    };
+    let (at, wanted) = (problem.position(state), problem.final_position_at(t));
+    let dims = problem.dim();
+    at.iter()
+        .zip(wanted)
+        .take(dims)
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// The quality of `tr`, exported from an NLP solution of `quality`: an `Optimal` solution
+/// whose export misses its end by more than [`EXPORT_END_TOL_M`] is only `Feasible` (and
+/// the service refines it at once).
+pub(super) fn exported_quality(problem: &Problem, tr: &Trajectory, quality: Quality) -> Quality {
+    if quality == Quality::Optimal && end_miss_m(problem, tr) > EXPORT_END_TOL_M {
+        Quality::Feasible
+    } else {
+        quality
+    }
+}
+
 /// The objective (FORMULATION.md §4) of a sampled trajectory: `|u|²` integrated exactly
 /// for controls linear between samples, `E` by composite Simpson on the samples.
 pub fn trajectory_cost(problem: &Problem, tr: &Trajectory) -> f64 {
@@ -473,6 +508,42 @@ mod tests {
         }
         tr.phase_ends = vec![100.0];
         tr
+    }
+
+    /// An `Optimal` solution whose export ends more than 50 m from the final point is only
+    /// `Feasible`; the miss is the horizontal distance in 2-D (the third state entry is
+    /// the heading), checked against the 3-4-5 triangle.
+    #[test]
+    fn an_export_that_misses_its_end_is_not_optimal() {
+        let sc = crate::scenario::bundled("2d-min-time-avoidable")
+            .unwrap()
+            .unwrap();
+        let problem = Problem::from_scenario(&sc).unwrap();
+        let end = problem.final_position_at(0.0);
+        let ending_at = |dx: f64, dy: f64| {
+            let mut tr = line(0.0);
+            let last = tr.states.len() - 1;
+            tr.states[last][0] = end[0] + dx;
+            tr.states[last][1] = end[1] + dy;
+            tr.states[last][2] = 2.5;
+            tr
+        };
+        assert!(end_miss_m(&problem, &ending_at(0.0, 0.0)) < 1e-9);
+        assert!((end_miss_m(&problem, &ending_at(30.0, 40.0)) - 50.0).abs() < 1e-9);
+        let q = |tr: &Trajectory, q| exported_quality(&problem, tr, q);
+        assert_eq!(
+            q(&ending_at(27.0, 36.0), Quality::Optimal),
+            Quality::Optimal
+        );
+        assert_eq!(
+            q(&ending_at(33.0, 44.0), Quality::Optimal),
+            Quality::Feasible
+        );
+        assert_eq!(
+            q(&ending_at(33.0, 44.0), Quality::Feasible),
+            Quality::Feasible
+        );
+        assert_eq!(end_miss_m(&problem, &Trajectory::default()), f64::INFINITY);
     }
 
     #[test]

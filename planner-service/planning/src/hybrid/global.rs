@@ -11,7 +11,7 @@ use super::timing::{Ranking, Seen, SolveTiming, StageTiming};
 use super::waves::{self, Waves};
 use super::{
     Gathered, PlanError, PlanOutcome, PlanPath, PlanSolution, Planner, PlannerSettings, StageTimes,
-    gather, ranking_meshes, reference_export, schedule, trajectory_cost,
+    exported_quality, gather, ranking_meshes, reference_export, schedule, trajectory_cost,
 };
 use crate::basins;
 use crate::clock::Deadline;
@@ -156,7 +156,8 @@ impl Planner {
             Some((a, _)) => {
                 let mut flown = Trajectory::default();
                 export(&a.tr, &a.x, &settings.export, &mut flown);
-                (quality_of_floor.unwrap_or(a.quality), flown)
+                let quality = quality_of_floor.unwrap_or(a.quality);
+                (exported_quality(problem, &flown, quality), flown)
             }
             None => (Quality::SwarmOnly, fallback),
         };

@@ -14,7 +14,7 @@ use super::nlp_stage::{NlpStage, Solved};
 use super::timing::Seen;
 use super::{
     Gathered, NlpReport, PlanError, PlanOutcome, PlanPath, Planner, PlannerSettings, StageTimes,
-    gather, ranking_meshes, reference_export, schedule, trajectory_cost,
+    exported_quality, gather, ranking_meshes, reference_export, schedule, trajectory_cost,
 };
 use crate::basins::{self, StartRanking};
 use crate::clock::Deadline;
@@ -146,7 +146,8 @@ impl Planner {
             .map_or(f64::INFINITY, |t| trajectory_cost(problem, t));
         let quality = trajectory
             .as_ref()
-            .and(accepted.as_ref().map(|(a, _)| a.quality));
+            .zip(accepted.as_ref())
+            .map(|(t, (a, _))| exported_quality(problem, t, a.quality));
         Ok(WarmPlan {
             solution: accepted.and_then(|(a, _)| PlanSolution::of(a)),
             report: WarmReport {
