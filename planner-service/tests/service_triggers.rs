@@ -7,7 +7,7 @@
 
 use wingman_interfaces::*;
 use wingman_ipc::ServiceConfig;
-use wingman_ipc::config::ConfigError;
+use wingman_ipc::config::{ConfigError, TriggerConfig};
 use wingman_planner::service::triggers::*;
 use wingman_planning::estimation::{Estimate, GaussMarkov, MovingThreat, Road};
 use wingman_planning::plan_message::{
@@ -285,6 +285,36 @@ fn a_deviation_fires_beyond_the_bound_on_the_plan_flown() {
     let mut hold = ownship(7, 900.0, 0.0);
     hold.flags = OWNSHIP_HOLDING;
     assert!(!deviation_exceeded(&hold, 7, &b));
+}
+
+#[test]
+fn the_along_track_bound_tightens_near_the_end_of_a_free_final_time() {
+    let cfg = TriggerConfig::default();
+    let (along, end) = (cfg.deviation_along_m, cfg.deviation_along_end_m);
+    assert!(end < along, "the defaults tighten it: {end} < {along}");
+    let window = cfg.deviation_end_window_s;
+    let at = |fixed, now| DeviationBounds::at(&cfg, fixed, now, 1000.0).along_m;
+    // A min-time or rendezvous plan: the end bound from `window` before its end on.
+    assert_eq!(at(false, 1000.0 - window - 0.1), along);
+    assert_eq!(at(false, 1000.0 - window), end);
+    assert_eq!(at(false, 1005.0), end);
+    // A fixed final time keeps the plan's bound to the end.
+    assert_eq!(at(true, 999.0), along);
+    // The other bounds do not change.
+    let b = DeviationBounds::at(&cfg, false, 999.0, 1000.0);
+    assert_eq!(
+        (b.cross_m, b.vertical_m),
+        (cfg.deviation_cross_m, cfg.deviation_vertical_m)
+    );
+    // An end bound set above the plan's bound does not loosen it.
+    let loose = TriggerConfig {
+        deviation_along_end_m: 2.0 * along,
+        ..cfg.clone()
+    };
+    assert_eq!(
+        DeviationBounds::at(&loose, false, 999.0, 1000.0).along_m,
+        along
+    );
 }
 
 #[test]

@@ -92,6 +92,13 @@ pub struct TriggerConfig {
     /// Being ahead of or behind the plan beyond this re-plans, m (a constant airspeed
     /// cannot make it up; a gust or a wind the plan did not know builds it up).
     pub deviation_along_m: f64,
+    /// The along-track bound in the last `deviation_end_window_s` of a plan that does not
+    /// fix its final time (min-time, rendezvous), m: the deviation left at the end is the
+    /// end's miss, and a new plan there only re-times the arrival. A fixed final time
+    /// keeps `deviation_along_m` to its end: late in the mission no path makes up for it.
+    pub deviation_along_end_m: f64,
+    /// How long before a plan's final time `deviation_along_end_m` applies, s.
+    pub deviation_end_window_s: f64,
     /// A scheduled re-plan time `t_r` is looked for only this long after a plan's start,
     /// s: a plan just made from the newest estimate is not re-made at once.
     pub replan_min_lead_s: f64,
@@ -195,6 +202,8 @@ impl Default for TriggerConfig {
             deviation_cross_m: 500.0,
             deviation_vertical_m: 200.0,
             deviation_along_m: 100.0,
+            deviation_along_end_m: 50.0,
+            deviation_end_window_s: 180.0,
             replan_min_lead_s: 1.0,
             first_plan_wait_ms: 300,
             refine: true,
@@ -338,11 +347,18 @@ impl ServiceConfig {
             ("triggers.deviation_cross_m", t.deviation_cross_m),
             ("triggers.deviation_vertical_m", t.deviation_vertical_m),
             ("triggers.deviation_along_m", t.deviation_along_m),
+            ("triggers.deviation_along_end_m", t.deviation_along_end_m),
             ("triggers.lead_off_route_m", t.lead_off_route_m),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return bad(key, format!("must be positive, got {v}"));
             }
+        }
+        if !(t.deviation_end_window_s.is_finite() && t.deviation_end_window_s >= 0.0) {
+            return bad(
+                "triggers.deviation_end_window_s",
+                "must not be negative".into(),
+            );
         }
         if !(t.replan_min_lead_s.is_finite() && t.replan_min_lead_s >= 0.0) {
             return bad("triggers.replan_min_lead_s", "must not be negative".into());

@@ -25,6 +25,7 @@ use wingman_interfaces::{
     LeadRoute, LeadState, Model, OwnshipState, Quality, Tasking, Trigger, Wire,
 };
 
+use wingman_ipc::config::TriggerConfig;
 use wingman_planning::lead::LeadPath;
 
 use wingman_planning::estimation::MovingThreat;
@@ -219,6 +220,24 @@ pub struct DeviationBounds {
     /// Ahead of or behind the plan: at a constant airspeed only a new plan makes up for
     /// it, and a rendezvous or a fixed final time needs it made up.
     pub along_m: f64,
+}
+
+impl DeviationBounds {
+    /// The bounds of the trigger configuration at mission time `now` for a plan ending at
+    /// `final_time_s`: near the end of a plan whose final time is free (`fixed_time`
+    /// false), the tighter along-track bound, since what is left there is the end's miss.
+    pub fn at(cfg: &TriggerConfig, fixed_time: bool, now: f64, final_time_s: f64) -> Self {
+        let near_end = !fixed_time && final_time_s - now <= cfg.deviation_end_window_s;
+        DeviationBounds {
+            cross_m: cfg.deviation_cross_m,
+            vertical_m: cfg.deviation_vertical_m,
+            along_m: if near_end {
+                cfg.deviation_along_end_m.min(cfg.deviation_along_m)
+            } else {
+                cfg.deviation_along_m
+            },
+        }
+    }
 }
 
 /// Whether the ownship, flying the plan `current_plan_id`, deviates from it beyond the

@@ -229,11 +229,17 @@ impl MessageLoop {
             info!(holding, "plan expires");
             self.raise(Trigger::Expiry);
         }
-        let bounds = DeviationBounds {
-            cross_m: self.cfg.triggers.deviation_cross_m,
-            vertical_m: self.cfg.triggers.deviation_vertical_m,
-            along_m: self.cfg.triggers.deviation_along_m,
-        };
+        let fixed_time = self
+            .world
+            .tasking
+            .as_ref()
+            .is_none_or(|t| t.objective() == Some(Objective::FixedTime));
+        let bounds = DeviationBounds::at(
+            &self.cfg.triggers,
+            fixed_time,
+            now,
+            self.current.final_time_s,
+        );
         if self.fired.deviation != id
             && let Some(o) = &self.world.ownship
             && triggers::deviation_exceeded(o, id, &bounds)
