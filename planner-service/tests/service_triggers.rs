@@ -597,3 +597,30 @@ fn a_pending_deviation_splices_from_the_ownship_whatever_names_the_plan() {
     restart.insert(Trigger::Tasking);
     assert!(splice_from_ownship(restart, false));
 }
+
+#[test]
+fn a_deviation_re_plan_that_did_not_converge_keeps_the_plan_in_flight() {
+    let set = |ts: &[Trigger]| {
+        let mut s = TriggerSet::EMPTY;
+        for &t in ts {
+            s.insert(t);
+        }
+        s
+    };
+    let deviation = set(&[Trigger::Deviation]);
+    assert!(keeps_plan_in_flight(deviation, Quality::SwarmOnly));
+    // A converged or feasible deviation re-plan is flown (a feasible one refined).
+    assert!(!keeps_plan_in_flight(deviation, Quality::Optimal));
+    assert!(!keeps_plan_in_flight(deviation, Quality::Feasible));
+    // With another trigger the plan in flight no longer answers everything: the new
+    // plan is flown, and refined.
+    assert!(!keeps_plan_in_flight(
+        set(&[Trigger::Deviation, Trigger::PopUp]),
+        Quality::SwarmOnly
+    ));
+    assert!(!keeps_plan_in_flight(
+        set(&[Trigger::LeadRoute]),
+        Quality::SwarmOnly
+    ));
+    assert!(!keeps_plan_in_flight(TriggerSet::EMPTY, Quality::SwarmOnly));
+}

@@ -333,11 +333,16 @@ impl InnerLoop {
     }
 
     /// The tracker's command at `t` for the state `x` it sees: the tracking law on the
-    /// flown plan's point abeam `x`, or the safe hold.
+    /// flown plan's point abeam `x`, its feed-forward the plan's control one response time
+    /// of the aircraft later (a first-order lag then applies it when the plan does), or
+    /// the safe hold.
     fn command(&self, t: f64, x: &[f64; 7]) -> [f64; 2] {
         match (self.flying(), self.holding()) {
             (Some(p), false) => {
-                let (xr, ur) = abeam(&p.plan, &self.tracker, t, x, self.limits.speed);
+                let at = abeam_time(&p.plan, &self.tracker, t, x, self.limits.speed);
+                let lead_s = self.truth.as_ref().map_or(0.0, Truth::response_s);
+                let (xr, _) = reference(&p.plan, at);
+                let (_, ur) = reference(&p.plan, at + lead_s);
                 self.tracker.control(x, &xr, &ur)
             }
             _ => hold_control(self.model, &self.limits, x),
@@ -428,13 +433,16 @@ pub fn abeam(
     x: &[f64; 7],
     speed: f64,
 ) -> ([f64; 7], [f64; 2]) {
+    reference(plan, abeam_time(plan, tracker, t, x, speed))
+}
+
+/// The plan time of the point abeam `x` ([`abeam`]).
+pub fn abeam_time(plan: &Plan, tracker: &Tracker, t: f64, x: &[f64; 7], speed: f64) -> f64 {
     let mut at = t;
-    let mut point = reference(plan, at);
     for _ in 0..2 {
-        at += tracker.deviation(x, &point.0).along_m / speed;
-        point = reference(plan, at);
+        at += tracker.deviation(x, &reference(plan, at).0).along_m / speed;
     }
-    point
+    at
 }
 
 /// The safe hold: a level turn to the left. 2-D: half the turn-rate limit. 3-D: bank

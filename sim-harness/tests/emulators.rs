@@ -7,13 +7,14 @@ use wingman_harness::clock::{ClockMode, Pacer, Periodic, step_time};
 use wingman_harness::datalink::Datalink;
 use wingman_harness::sensor::{SensorOutput, ThreatSensor};
 use wingman_harness::tracker::{InnerLoop, ReceivedPlan, abeam, reference};
+use wingman_harness::truth::Truth;
 use wingman_interfaces::{
     Header, Model, OWNSHIP_HOLDING, Plan, Quality, SENDER_PLANNER, Trigger, Wire,
 };
 use wingman_planning::dynamics::{Planar, rk4_step_with};
 use wingman_planning::plan_message::{PlanInfo, set_next_replan, write_plan};
 use wingman_planning::problem::Problem;
-use wingman_planning::scenario::{Scenario, bundled};
+use wingman_planning::scenario::{AircraftSpec, Scenario, bundled};
 use wingman_planning::tracking::{Tracker, TrackingGains};
 use wingman_planning::trajectory::Trajectory;
 
@@ -144,6 +145,48 @@ fn the_disturbed_tracker_follows_the_point_abeam() {
             "the points differ: {moved} m"
         );
     }
+}
+
+/// The largest cross-track deviation of an aircraft that lags its commands by
+/// `response_s` (nothing else disturbs it) flying [`planar_plan`]'s turn, m.
+fn worst_cross_track_in_the_turn(response_s: f64) -> f64 {
+    let mut sc = scenario("2d-min-time-avoidable");
+    let problem = Problem::from_scenario(&sc).unwrap();
+    sc.aircraft = Some(AircraftSpec {
+        response_s,
+        turn_accel_max: f64::INFINITY,
+        nz_rate_max: problem.limits.nz_rate_max,
+        mu_rate_max: problem.limits.mu_rate_max,
+        nav_sigma_m: 0.0,
+        nav_heading_sigma: 0.0,
+        nav_tau_s: 1.0,
+        seed: 0,
+    });
+    let x0 = [problem.x0[0], problem.x0[1], problem.x0[2]];
+    let mut tl = InnerLoop::new(&problem, TrackingGains::default())
+        .unwrap()
+        .with_truth(Truth::of(&sc, &problem));
+    tl.receive(received(planar_plan(&problem, 1, 0.0, x0, 400.0), 0.0));
+    (1..=3000)
+        .map(|k| {
+            tl.advance_to(0.1 * k as f64);
+            tl.sample().deviation.cross_m.abs()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The disturbed tracker's feed-forward is the plan's control one response time of the
+/// aircraft ahead: behind a first-order lag of time constant `tau` the applied turn rate
+/// then follows the plan's to the order of `tau^2` times its rate of change (here at most
+/// 0.64 s^2 x 0.0014 rad/s^2 ~ 1e-3 rad/s) where the plan's own control would leave it
+/// `tau` x the turn rate behind (0.8 s x 0.044 rad/s ~ 0.035 rad of heading at the height
+/// of the turn). The aircraft flies the turn within 5 m, as one without the lag does.
+#[test]
+fn the_disturbed_tracker_leads_its_command_by_the_aircrafts_response() {
+    let without_lag = worst_cross_track_in_the_turn(0.0);
+    let lagging = worst_cross_track_in_the_turn(0.8);
+    assert!(without_lag < 1.0, "no lag: {without_lag} m");
+    assert!(lagging < 5.0, "a 0.8 s lag: {lagging} m");
 }
 
 #[test]

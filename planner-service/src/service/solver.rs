@@ -21,6 +21,8 @@ use crossbeam::channel::{self, Receiver, RecvTimeoutError, Sender};
 use tracing::{error, info, info_span};
 use wingman_interfaces::{Quality, Trigger};
 
+use crate::service::triggers::TriggerSet;
+
 use wingman_planning::clock::{Clock, Deadline};
 use wingman_planning::cuts::{Cut, CutList, CutLog, ReplayCuts};
 use wingman_planning::hybrid::{FlyingPlan, PlanError, PlanOutcome, Planner, PlannerSettings};
@@ -31,6 +33,8 @@ use wingman_planning::problem::Problem;
 pub struct Ticket {
     pub plan_id: u64,
     pub trigger: Trigger,
+    /// Every trigger the plan answers (`trigger` is the first of them).
+    pub triggers: TriggerSet,
     /// Mission time of the trigger.
     pub created_at_s: f64,
     /// Compute budget (the deadline).

@@ -306,6 +306,23 @@ pub fn refine_due(enabled: bool, made: Quality, trigger: Trigger, enters_new_thr
     enabled && trigger != Trigger::Refine && (made != Quality::Optimal || enters_new_threat)
 }
 
+/// Whether a plan made for the triggers `set` is dropped and the plan in flight kept: a
+/// re-plan for a deviation alone that did not converge (`SwarmOnly`, the swarm's path).
+/// The plan in flight still takes the aircraft through every target to the end (the
+/// tracker flies back to it), where the swarm's path may miss them by hundreds of metres;
+/// a deviation re-plan fails so mostly a few seconds before a target, where the deviated
+/// aircraft has no room left to turn through it. The deviation may re-plan again
+/// [`DEVIATION_RETRY_S`] later.
+pub fn keeps_plan_in_flight(set: TriggerSet, made: Quality) -> bool {
+    made == Quality::SwarmOnly
+        && set.contains(Trigger::Deviation)
+        && set.only_of(&[Trigger::Deviation])
+}
+
+/// Mission time after a dropped deviation re-plan ([`keeps_plan_in_flight`]) before the
+/// deviation from the same plan may re-plan again, s.
+pub const DEVIATION_RETRY_S: f64 = 10.0;
+
 /// Whether the triggers `set` ask only for a refinement (it has its own budget, between a
 /// re-plan's and a plan from scratch's).
 pub fn refine_only(set: TriggerSet) -> bool {

@@ -39,6 +39,11 @@ impl Autopilot {
         }
     }
 
+    /// The time constant of the lag, s.
+    pub fn response_s(&self) -> f64 {
+        self.response_s
+    }
+
     /// The control applied over the next `h` seconds when commanded `command`: the lag's
     /// exact step towards the command, its change limited (2-D), then clamped.
     pub fn respond(&mut self, command: [f64; 2], h: f64) -> [f64; 2] {

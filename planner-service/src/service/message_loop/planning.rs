@@ -41,8 +41,18 @@ impl Batch {
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct FiredFor {
     deviation: u64,
+    /// Mission time from which a deviation from the plan `deviation` may re-plan again:
+    /// its re-plan was dropped ([`triggers::keeps_plan_in_flight`]). Never otherwise.
+    deviation_retry_s: Option<f64>,
     expiry: u64,
     scheduled: u64,
+}
+
+impl FiredFor {
+    /// The deviation from the plan in flight may re-plan again from mission time `at`.
+    pub(super) fn retry_deviation_at(&mut self, at: f64) {
+        self.deviation_retry_s = Some(at);
+    }
 }
 
 impl MessageLoop {
@@ -240,11 +250,13 @@ impl MessageLoop {
             now,
             self.current.final_time_s,
         );
-        if self.fired.deviation != id
+        let retry = self.fired.deviation_retry_s.is_some_and(|at| now >= at);
+        if (self.fired.deviation != id || retry)
             && let Some(o) = &self.world.ownship
             && triggers::deviation_exceeded(o, id, &bounds)
         {
             self.fired.deviation = id;
+            self.fired.deviation_retry_s = None;
             info!(
                 cross_m = o.cross_track_m,
                 vertical_m = o.vertical_m,
@@ -307,6 +319,7 @@ impl MessageLoop {
         let ticket = Ticket {
             plan_id: self.next_plan_id,
             trigger,
+            triggers: set,
             created_at_s,
             budget,
             epoch: self.world.epoch,

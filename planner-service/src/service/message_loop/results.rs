@@ -84,8 +84,24 @@ impl MessageLoop {
         touches
     }
 
-    /// Publishes a plan made by the solver and makes it current.
+    /// Publishes a plan made by the solver and makes it current, unless the plan in flight
+    /// is better kept ([`triggers::keeps_plan_in_flight`]).
     fn accept(&mut self, o: &PlanOutcome, ticket: &Ticket, compute_ms: f64, cuts: &[Cut]) {
+        let now = self.world.now_s();
+        if self.has_plan
+            && triggers::keeps_plan_in_flight(ticket.triggers, o.quality)
+            && self.current.valid_until_s > now
+        {
+            info!(
+                plan_id = self.current.plan_id,
+                quality = o.quality.name(),
+                cost = o.cost,
+                "the deviation re-plan did not converge: the plan in flight is kept"
+            );
+            self.fired
+                .retry_deviation_at(now + triggers::DEVIATION_RETRY_S);
+            return;
+        }
         // The model, speed and wind of the problem planned (the tasking may have changed
         // since).
         let Some((model, speed, wind)) = self

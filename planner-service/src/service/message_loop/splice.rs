@@ -76,8 +76,16 @@ impl MessageLoop {
         let from_ownship = triggers::splice_from_ownship(set, holding);
         let mission_over =
             plan.is_some_and(|p| p.valid_until_s >= p.final_time_s && t_c >= p.final_time_s);
-        if mission_over && set.only_of(&[Trigger::PopUp, Trigger::ScheduledReplan, Trigger::Refine])
-        {
+        // (A deviation there is the aircraft arriving behind the plan: a plan from it would
+        // last the budget's few seconds, too short for the NLP, and a swarm's path there
+        // turns the aircraft away from the end it is about to reach.)
+        let ends_anyway = [
+            Trigger::PopUp,
+            Trigger::ScheduledReplan,
+            Trigger::Refine,
+            Trigger::Deviation,
+        ];
+        if mission_over && set.only_of(&ends_anyway) {
             info!(
                 trigger = trigger.name(),
                 "the plan ends before the commit time: no re-plan"
