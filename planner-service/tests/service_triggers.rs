@@ -599,7 +599,8 @@ fn a_pending_deviation_splices_from_the_ownship_whatever_names_the_plan() {
 }
 
 #[test]
-fn a_deviation_re_plan_that_did_not_converge_keeps_the_plan_in_flight() {
+fn a_deviation_re_plan_into_a_threat_or_short_of_the_nlp_keeps_the_plan_in_flight() {
+    use DeviationPlan::*;
     let set = |ts: &[Trigger]| {
         let mut s = TriggerSet::EMPTY;
         for &t in ts {
@@ -608,19 +609,41 @@ fn a_deviation_re_plan_that_did_not_converge_keeps_the_plan_in_flight() {
         s
     };
     let deviation = set(&[Trigger::Deviation]);
-    assert!(keeps_plan_in_flight(deviation, Quality::SwarmOnly));
-    // A converged or feasible deviation re-plan is flown (a feasible one refined).
-    assert!(!keeps_plan_in_flight(deviation, Quality::Optimal));
-    assert!(!keeps_plan_in_flight(deviation, Quality::Feasible));
-    // With another trigger the plan in flight no longer answers everything: the new
-    // plan is flown, and refined.
-    assert!(!keeps_plan_in_flight(
-        set(&[Trigger::Deviation, Trigger::PopUp]),
-        Quality::SwarmOnly
-    ));
-    assert!(!keeps_plan_in_flight(
-        set(&[Trigger::LeadRoute]),
-        Quality::SwarmOnly
-    ));
-    assert!(!keeps_plan_in_flight(TriggerSet::EMPTY, Quality::SwarmOnly));
+    let refinement = set(&[Trigger::Deviation, Trigger::Refine]);
+    assert!(refines_deviation(refinement));
+    assert!(!refines_deviation(deviation));
+    assert!(!refines_deviation(set(&[Trigger::Refine])));
+    for (s, made, enters, then) in [
+        // Into a threat the plan in flight avoids: dropped, converged or not.
+        (deviation, Quality::Optimal, true, KeepAndRetry),
+        (refinement, Quality::Feasible, true, KeepAndRetry),
+        // The swarm's path: refined from the ownship; once refined, kept.
+        (deviation, Quality::SwarmOnly, false, KeepAndRefine),
+        (refinement, Quality::SwarmOnly, false, KeepAndRetry),
+        // Anything else is flown (a Feasible one refined as usual).
+        (deviation, Quality::Optimal, false, Publish),
+        (deviation, Quality::Feasible, false, Publish),
+        (refinement, Quality::Optimal, false, Publish),
+        // With another trigger the plan in flight no longer answers everything.
+        (
+            set(&[Trigger::Deviation, Trigger::PopUp]),
+            Quality::SwarmOnly,
+            true,
+            Publish,
+        ),
+        (
+            set(&[Trigger::LeadRoute]),
+            Quality::SwarmOnly,
+            true,
+            Publish,
+        ),
+        (set(&[Trigger::Refine]), Quality::SwarmOnly, true, Publish),
+        (TriggerSet::EMPTY, Quality::SwarmOnly, true, Publish),
+    ] {
+        assert_eq!(
+            deviation_plan(s, made, enters),
+            then,
+            "{s:?} {made:?} {enters}"
+        );
+    }
 }

@@ -336,7 +336,7 @@ impl MessageLoop {
             .unwrap_or(Model::ThreeD);
         if !self.replans_in_flight(set) {
             self.cfg.plan_budget(model)
-        } else if triggers::refine_only(set) {
+        } else if triggers::refine_only(set) || triggers::refines_deviation(set) {
             self.cfg.refine_budget(model)
         } else {
             self.cfg.replan_budget(model)

@@ -42,7 +42,7 @@ impl Batch {
 pub(super) struct FiredFor {
     deviation: u64,
     /// Mission time from which a deviation from the plan `deviation` may re-plan again:
-    /// its re-plan was dropped ([`triggers::keeps_plan_in_flight`]). Never otherwise.
+    /// its re-plan was dropped ([`triggers::deviation_plan`]). Never otherwise.
     deviation_retry_s: Option<f64>,
     expiry: u64,
     scheduled: u64,

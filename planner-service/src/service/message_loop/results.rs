@@ -8,7 +8,7 @@ use wingman_interfaces::{Header, SENDER_PLANNER, Trigger};
 use super::lifecycle::{FirstPlan, PlanLifecycle};
 use super::{FIRST_PLAN_RETRY, MessageLoop};
 use crate::service::solver::{SolveResult, Ticket};
-use crate::service::triggers;
+use crate::service::triggers::{self, DeviationPlan};
 use crate::service::world::{self, ThreatSlot};
 use wingman_planning::cuts::Cut;
 use wingman_planning::hybrid::PlanOutcome;
@@ -85,23 +85,8 @@ impl MessageLoop {
     }
 
     /// Publishes a plan made by the solver and makes it current, unless the plan in flight
-    /// is better kept ([`triggers::keeps_plan_in_flight`]).
+    /// is better kept ([`triggers::deviation_plan`]).
     fn accept(&mut self, o: &PlanOutcome, ticket: &Ticket, compute_ms: f64, cuts: &[Cut]) {
-        let now = self.world.now_s();
-        if self.has_plan
-            && triggers::keeps_plan_in_flight(ticket.triggers, o.quality)
-            && self.current.valid_until_s > now
-        {
-            info!(
-                plan_id = self.current.plan_id,
-                quality = o.quality.name(),
-                cost = o.cost,
-                "the deviation re-plan did not converge: the plan in flight is kept"
-            );
-            self.fired
-                .retry_deviation_at(now + triggers::DEVIATION_RETRY_S);
-            return;
-        }
         // The model, speed and wind of the problem planned (the tasking may have changed
         // since).
         let Some((model, speed, wind)) = self
@@ -142,10 +127,12 @@ impl MessageLoop {
                  take its course"
             );
         }
-        // The known static threats the plan in flight enters, before it is replaced.
-        let entered_before = self.has_plan.then(|| self.static_threats_entered());
+        let enters_new = self.new_plan_enters_new_threat(speed, wind);
+        if self.keeps_plan_in_flight(o, ticket, enters_new) {
+            self.points.fill(&self.current, speed, wind);
+            return;
+        }
         // Scheduled re-plans of the moving threats over the new plan.
-        self.points.fill(&self.scratch, speed, wind);
         std::mem::swap(&mut self.current, &mut self.scratch);
         self.has_plan = true;
         let slots: [Option<usize>; world::MAX_MOVING_THREATS] = {
@@ -179,16 +166,8 @@ impl MessageLoop {
             next_replan_s = self.current.next_replan(),
             "plan published"
         );
-        // A plan that enters a known static threat the plan before it kept clear of: a
-        // re-plan whose short budget left it in a basin across the threat (the plan in
-        // flight dragged across it by a new rendezvous, or pressed into it by a moving
-        // threat); the refinement's global search has the time to look around it.
-        let enters_new = entered_before.is_some_and(|before| {
-            let now = self.static_threats_entered();
-            now.iter()
-                .zip(&before)
-                .any(|(now, before)| *now && !*before)
-        });
+        // A plan that enters a known static threat the plan before it kept clear of: the
+        // refinement's global search has the time to look around it.
         if triggers::refine_due(
             self.cfg.triggers.refine,
             o.quality,
@@ -202,6 +181,54 @@ impl MessageLoop {
             );
             self.raise(Trigger::Refine);
         }
+    }
+
+    /// Whether the plan written into `scratch` enters a known static threat the plan in
+    /// flight kept clear of: a re-plan whose short budget left it in a basin across the
+    /// threat (the plan in flight dragged across it by a new rendezvous or a deviation, or
+    /// pressed into it by a moving threat). Leaves the plan points on the new plan.
+    fn new_plan_enters_new_threat(&mut self, speed: f64, wind: [f64; 3]) -> bool {
+        let before = self.has_plan.then(|| self.static_threats_entered());
+        self.points.fill(&self.scratch, speed, wind);
+        before.is_some_and(|before| {
+            let now = self.static_threats_entered();
+            now.iter()
+                .zip(&before)
+                .any(|(now, before)| *now && !*before)
+        })
+    }
+
+    /// Whether the plan `o` made for `ticket` is dropped and the plan in flight kept
+    /// ([`triggers::deviation_plan`]); if so the deviation is refined at once or may
+    /// re-plan again later.
+    fn keeps_plan_in_flight(&mut self, o: &PlanOutcome, ticket: &Ticket, enters_new: bool) -> bool {
+        let now = self.world.now_s();
+        if !(self.has_plan && self.current.valid_until_s > now) {
+            return false;
+        }
+        let then = triggers::deviation_plan(ticket.triggers, o.quality, enters_new);
+        if then == DeviationPlan::Publish {
+            return false;
+        }
+        info!(
+            plan_id = self.current.plan_id,
+            quality = o.quality.name(),
+            cost = o.cost,
+            enters_new_threat = enters_new,
+            then = ?then,
+            "the deviation re-plan did not converge or enters a threat the plan in flight \
+             avoids: the plan in flight is kept"
+        );
+        match then {
+            DeviationPlan::KeepAndRefine => {
+                self.raise(Trigger::Deviation);
+                self.raise(Trigger::Refine);
+            }
+            _ => self
+                .fired
+                .retry_deviation_at(now + triggers::DEVIATION_RETRY_S),
+        }
+        true
     }
 
     fn publish_plan(&mut self) {
