@@ -601,13 +601,7 @@ fn a_pending_deviation_splices_from_the_ownship_whatever_names_the_plan() {
 #[test]
 fn a_deviation_re_plan_into_a_threat_or_short_of_the_nlp_keeps_the_plan_in_flight() {
     use DeviationPlan::*;
-    let set = |ts: &[Trigger]| {
-        let mut s = TriggerSet::EMPTY;
-        for &t in ts {
-            s.insert(t);
-        }
-        s
-    };
+    let set = TriggerSet::of;
     let deviation = set(&[Trigger::Deviation]);
     let refinement = set(&[Trigger::Deviation, Trigger::Refine]);
     assert!(refines_deviation(refinement));

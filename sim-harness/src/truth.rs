@@ -68,13 +68,13 @@ impl Truth {
         self.autopilot.applying(control);
     }
 
-    /// The control the aircraft applies over the next `h` seconds when commanded
-    /// `command`.
     /// The time constant of the aircraft's lag behind its commands, s.
     pub fn response_s(&self) -> f64 {
         self.autopilot.response_s()
     }
 
+    /// The control the aircraft applies over the next `h` seconds when commanded
+    /// `command`.
     pub fn respond(&mut self, command: [f64; 2], h: f64) -> [f64; 2] {
         self.autopilot.respond(command, h)
     }

@@ -331,7 +331,7 @@ pub enum DeviationPlan {
 /// target, and on a long mission the refinement's budget converges where the re-plan's
 /// did not. If the refinement does not converge either, the plan in flight stays.
 pub fn deviation_plan(set: TriggerSet, made: Quality, enters_new_threat: bool) -> DeviationPlan {
-    let deviation_only = set.contains(Trigger::Deviation) && set.only_of(&[Trigger::Deviation]);
+    let deviation_only = set.is_exactly(&[Trigger::Deviation]);
     let refinement = refines_deviation(set);
     if !(deviation_only || refinement) {
         DeviationPlan::Publish
@@ -347,9 +347,7 @@ pub fn deviation_plan(set: TriggerSet, made: Quality, enters_new_threat: bool) -
 /// Whether the triggers `set` refine a deviation re-plan (a deviation and a refinement,
 /// nothing else): planned from the ownship with the refinement's budget.
 pub fn refines_deviation(set: TriggerSet) -> bool {
-    set.contains(Trigger::Deviation)
-        && set.contains(Trigger::Refine)
-        && set.only_of(&[Trigger::Deviation, Trigger::Refine])
+    set.is_exactly(&[Trigger::Deviation, Trigger::Refine])
 }
 
 /// Mission time after a dropped deviation re-plan ([`deviation_plan`]) before the
@@ -359,7 +357,7 @@ pub const DEVIATION_RETRY_S: f64 = 10.0;
 /// Whether the triggers `set` ask only for a refinement (it has its own budget, between a
 /// re-plan's and a plan from scratch's).
 pub fn refine_only(set: TriggerSet) -> bool {
-    set.only_of(&[Trigger::Refine]) && set.contains(Trigger::Refine)
+    set.is_exactly(&[Trigger::Refine])
 }
 
 /// Whether the first plan of a tasking is a restart: the tracker already flies a plan
@@ -391,6 +389,20 @@ const PRIORITY: [Trigger; 10] = [
 
 impl TriggerSet {
     pub const EMPTY: TriggerSet = TriggerSet(0);
+
+    /// The set of `triggers`.
+    pub fn of(triggers: &[Trigger]) -> TriggerSet {
+        let mut set = TriggerSet::EMPTY;
+        for &t in triggers {
+            set.insert(t);
+        }
+        set
+    }
+
+    /// Whether the set holds `triggers` and nothing else.
+    pub fn is_exactly(&self, triggers: &[Trigger]) -> bool {
+        *self == TriggerSet::of(triggers)
+    }
 
     pub fn insert(&mut self, t: Trigger) {
         self.0 |= 1 << t.to_wire();
