@@ -337,7 +337,8 @@ impl FlyingPlan {
     /// The start of a re-plan of `problem` from this plan: its samples after `problem`'s
     /// start, behind `problem`'s start state, the passed targets' phases dropped, the
     /// heading turned by whole turns to continue the start state's. `None` if `problem`
-    /// does not continue this plan's tasking.
+    /// does not continue this plan's tasking, or if it is a rendezvous whose lead is no
+    /// longer near the plan's end ([`FAR_LEAD_SHARE`]).
     pub fn guess_for(&self, problem: &Problem) -> Option<Trajectory> {
         let dropped = self.passed_targets(problem)?;
         let t0 = problem.t0;
@@ -363,8 +364,37 @@ impl FlyingPlan {
             *e = e.max(prev + 1e-3);
             prev = *e;
         }
-        (guess.len() >= 2 && guess.is_valid()).then_some(guess)
+        (guess.len() >= 2 && guess.is_valid() && ends_near_the_lead(problem, &guess))
+            .then_some(guess)
     }
+}
+
+/// A rendezvous guess whose end is farther than this share of its length from where the
+/// lead is at the guess's final time does not continue its plan.
+const FAR_LEAD_SHARE: f64 = 0.1;
+
+/// Whether `guess` (the plan in flight cut at `problem`'s start) ends near the lead of a
+/// rendezvous `problem` at the guess's final time (any other problem keeps the end its
+/// plan was made for: a continued tasking has the same final point). A new route, or a
+/// lead off its route, may move the meeting far: a plan made for another meeting is no
+/// start for the new one. Dragged to it, it converged across a static threat the plan went
+/// around (c1-0061: the meeting moved 85 km on the 282 km left; docs/decisions/0045).
+fn ends_near_the_lead(problem: &Problem, guess: &Trajectory) -> bool {
+    let Some(lead) = &problem.lead else {
+        return true;
+    };
+    let (Some(tf), Some(end)) = (guess.final_time(), guess.states.last()) else {
+        return false;
+    };
+    let distance = |a: [f64; 3], b: [f64; 3]| {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    };
+    let length: f64 = guess
+        .states
+        .windows(2)
+        .map(|w| distance(problem.position(&w[0]), problem.position(&w[1])))
+        .sum();
+    distance(problem.position(end), lead.at(tf).position) <= FAR_LEAD_SHARE * length
 }
 
 #[cfg(test)]
@@ -419,6 +449,49 @@ mod tests {
         assert_eq!(guess.final_time(), Some(100.0));
         assert_eq!(guess.phase_ends, plan.path.phase_ends[1..]);
         assert_eq!(plan.passed_targets(&replan), Some(1));
+    }
+
+    /// The 2-D problem with the straight plan's rendezvous: the lead flies east at
+    /// 200 m/s, `offset_m` north of the plan's line: the plan ends at t = 100 `offset_m`
+    /// from where the lead is then.
+    fn rendezvous(offset_m: f64) -> Problem {
+        let mut problem = problem_with_targets();
+        problem.objective = Objective::MinTimeRendezvous;
+        problem.final_state = None;
+        problem.final_time = None;
+        problem.lead = Some(
+            crate::lead::LeadPath::new(
+                &[[0.0, offset_m, 0.0], [40_000.0, offset_m, 0.0]],
+                200.0,
+                0.0,
+            )
+            .expect("a valid lead"),
+        );
+        problem
+    }
+
+    #[test]
+    fn a_rendezvous_whose_lead_moved_far_from_the_plans_end_gives_no_warm_start() {
+        let plan = flying(&rendezvous(0.0));
+        let replan_for = |offset_m: f64| {
+            let mut replan = rendezvous(offset_m);
+            replan.t0 = 50.5;
+            replan.targets.remove(0);
+            replan.x0 = [200.0 * 50.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+            replan
+        };
+        // The plan left: 9 900 m. Its end 0 m and 900 m from the lead (a tenth of it:
+        // 990 m) continues it; 1 100 m does not.
+        assert!(plan.guess_for(&replan_for(0.0)).is_some());
+        assert!(plan.guess_for(&replan_for(900.0)).is_some());
+        assert_eq!(plan.guess_for(&replan_for(1_100.0)), None);
+        // The same lead behind or ahead: its position at the plan's end is what counts.
+        let mut late = replan_for(0.0);
+        late.lead = Some(
+            crate::lead::LeadPath::new(&[[0.0, 0.0, 0.0], [40_000.0, 0.0, 0.0]], 200.0, 6.0)
+                .expect("a valid lead"),
+        );
+        assert_eq!(plan.guess_for(&late), None, "1 200 m behind");
     }
 
     #[test]
