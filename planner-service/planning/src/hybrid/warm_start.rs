@@ -337,8 +337,8 @@ impl FlyingPlan {
     /// The start of a re-plan of `problem` from this plan: its samples after `problem`'s
     /// start, behind `problem`'s start state, the passed targets' phases dropped, the
     /// heading turned by whole turns to continue the start state's. `None` if `problem`
-    /// does not continue this plan's tasking, or if it is a rendezvous whose lead is no
-    /// longer near the plan's end ([`FAR_LEAD_SHARE`]).
+    /// does not continue this plan's tasking, or if it is a 2-D rendezvous whose lead is
+    /// no longer near the plan's end ([`FAR_LEAD_SHARE`]).
     pub fn guess_for(&self, problem: &Problem) -> Option<Trajectory> {
         let dropped = self.passed_targets(problem)?;
         let t0 = problem.t0;
@@ -369,8 +369,8 @@ impl FlyingPlan {
     }
 }
 
-/// A rendezvous guess whose end is farther than this share of its length from where the
-/// lead is at the guess's final time does not continue its plan.
+/// A 2-D rendezvous guess whose end is farther than this share of its length from where
+/// the lead is at the guess's final time does not continue its plan.
 const FAR_LEAD_SHARE: f64 = 0.1;
 
 /// Whether `guess` (the plan in flight cut at `problem`'s start) ends near the lead of a
@@ -379,8 +379,11 @@ const FAR_LEAD_SHARE: f64 = 0.1;
 /// lead off its route, may move the meeting far: a plan made for another meeting is no
 /// start for the new one. Dragged to it, it converged across a static threat the plan went
 /// around (c1-0061: the meeting moved 85 km on the 282 km left; docs/decisions/0045).
+/// In 2-D only: a 3-D plan from scratch does not fit a refinement's budget on a slow
+/// computer (1.5-2.6 s against 1.2 s), and its refinements came out `SwarmOnly` or
+/// `Feasible`, missing targets, in the campaign that tried it in 3-D too.
 fn ends_near_the_lead(problem: &Problem, guess: &Trajectory) -> bool {
-    let Some(lead) = &problem.lead else {
+    let Some(lead) = problem.lead.as_ref().filter(|_| problem.dim() == 2) else {
         return true;
     };
     let (Some(tf), Some(end)) = (guess.final_time(), guess.states.last()) else {
