@@ -120,7 +120,8 @@ impl LeadPath {
     }
 }
 
-fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+/// The straight-line distance between two points, m.
+pub(crate) fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2) + (b[2] - a[2]).powi(2)).sqrt()
 }
 

@@ -21,6 +21,7 @@ use crate::clock::Deadline;
 use crate::collocation::transcription::nearest_turn;
 use crate::collocation::{PrimalDual, Transcription, export};
 use crate::cuts::Work;
+use crate::lead::distance;
 use crate::problem::{Problem, Threats};
 use crate::seeding;
 use crate::swarm::SwarmError;
@@ -383,21 +384,21 @@ const FAR_LEAD_SHARE: f64 = 0.1;
 /// computer (take-off plans 0.9 s p50, 1.4 s p90 there), and 7 of 19 such refinements
 /// came out `SwarmOnly` or `Feasible` in the campaign that tried it in 3-D too.
 fn ends_near_the_lead(problem: &Problem, guess: &Trajectory) -> bool {
-    let Some(lead) = problem.lead.as_ref().filter(|_| problem.dim() == 2) else {
+    let Some(lead) = &problem.lead else {
         return true;
     };
+    if problem.dim() == 3 {
+        return true;
+    }
     let (Some(tf), Some(end)) = (guess.final_time(), guess.states.last()) else {
         return false;
-    };
-    let distance = |a: [f64; 3], b: [f64; 3]| {
-        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
     };
     let length: f64 = guess
         .states
         .windows(2)
-        .map(|w| distance(problem.position(&w[0]), problem.position(&w[1])))
+        .map(|w| distance(&problem.position(&w[0]), &problem.position(&w[1])))
         .sum();
-    distance(problem.position(end), lead.at(tf).position) <= FAR_LEAD_SHARE * length
+    distance(&problem.position(end), &lead.at(tf).position) <= FAR_LEAD_SHARE * length
 }
 
 #[cfg(test)]
