@@ -5,6 +5,8 @@
 //! Geometry of the pop-up and `t_r` cases: the plan flies east along `y = 0` at 200 m/s,
 //! `x = 200 t`, sampled every second for 100 s; it passes `x = 10 km` at `t = 50 s`.
 
+use std::time::Duration;
+
 use wingman_interfaces::*;
 use wingman_ipc::ServiceConfig;
 use wingman_ipc::config::{ConfigError, TriggerConfig};
@@ -563,7 +565,8 @@ fn a_bad_configuration_is_refused_naming_the_key() {
 #[test]
 fn the_duty_cycle_cap_holds_a_budget_per_thread() {
     // 600 ms x 2 threads = 1200 ms > 0.1 x 10 s.
-    let budget = "[budget]\nplan_2d_ms = 300\nplan_3d_ms = 600\nduty_cycle = 0.1\n";
+    let budget = "[budget]\ntakeoff_2d_ms = 300\ntakeoff_3d_ms = 600\nplan_2d_ms = 300\n\
+                  plan_3d_ms = 600\nduty_cycle = 0.1\n";
     let e = ServiceConfig::from_toml(budget, "x.toml").unwrap_err();
     assert!(
         e.to_string().contains("budget.duty_cycle") && e.to_string().contains("1200"),
@@ -578,6 +581,57 @@ fn the_duty_cycle_cap_holds_a_budget_per_thread() {
     assert!(e.to_string().contains("solver.threads"), "{e}");
     let e = ServiceConfig::from_toml("[budget]\nplan_3d_ms = 0\n", "x").unwrap_err();
     assert!(e.to_string().contains("budget.plan_3d_ms"), "{e}");
+    // The take-off budget counts too: 2.5 s x 2 threads > 0.4 x 10 s.
+    let e = ServiceConfig::from_toml("[budget]\nduty_cycle = 0.4\n", "x").unwrap_err();
+    assert!(e.to_string().contains("5000"), "{e}");
+    let e = ServiceConfig::from_toml("[budget]\ntakeoff_2d_ms = 0\n", "x").unwrap_err();
+    assert!(e.to_string().contains("budget.takeoff_2d_ms"), "{e}");
+}
+
+/// The take-off plan takes the take-off budget whatever else is pending; a plan from
+/// scratch in flight (a new tasking, a restart, no plan to re-plan) the plan budget; a
+/// refinement alone or of a deviation the refinement's; any other re-plan the re-plan's.
+#[test]
+fn each_plan_takes_the_budget_of_its_kind() {
+    let set = |ts: &[Trigger]| TriggerSet::of(ts);
+    let cases = [
+        (set(&[Trigger::Initial]), false, BudgetKind::TakeOff),
+        (
+            set(&[Trigger::Initial, Trigger::PopUp]),
+            false,
+            BudgetKind::TakeOff,
+        ),
+        (set(&[Trigger::Restart]), false, BudgetKind::FromScratch),
+        (set(&[Trigger::Tasking]), true, BudgetKind::FromScratch),
+        (set(&[Trigger::PopUp]), false, BudgetKind::FromScratch),
+        (set(&[Trigger::Refine]), true, BudgetKind::Refine),
+        (
+            set(&[Trigger::Deviation, Trigger::Refine]),
+            true,
+            BudgetKind::Refine,
+        ),
+        (
+            set(&[Trigger::PopUp, Trigger::Refine]),
+            true,
+            BudgetKind::Replan,
+        ),
+        (set(&[Trigger::LeadRoute]), true, BudgetKind::Replan),
+    ];
+    for (s, has_plan, kind) in cases {
+        assert_eq!(
+            budget_kind(s, has_plan),
+            kind,
+            "{s:?}, plan in flight {has_plan}"
+        );
+    }
+    // The deployment defaults: a take-off plan holds more than a plan from scratch in
+    // flight in 2-D, as much in 3-D.
+    let d = ServiceConfig::default();
+    assert_eq!(d.takeoff_budget(Model::TwoD), Duration::from_millis(2000));
+    assert_eq!(
+        d.takeoff_budget(Model::ThreeD),
+        d.plan_budget(Model::ThreeD)
+    );
 }
 
 /// B2: the splice starts from the ownship when any pending trigger is a deviation or a

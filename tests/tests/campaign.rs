@@ -101,9 +101,10 @@ fn a_ci_sized_campaign_meets_its_bars_and_four_merged_shards_give_its_outcomes()
     }
     // What it measures. The yardstick bar (≥ 98 % within 0.5 % of the yardstick)
     // is not met yet (docs/CAMPAIGN.md lists the misses); these are the floors of the
-    // planner as it stands, below what this campaign measured on the 2-core machine (30
-    // and 23 of 30; 26 meeting the criteria before re-plans short of optimal were
-    // refined), for a slower machine's cuts.
+    // planner as it stands, below what this campaign measured on the 2-core machine at
+    // half its usual speed (29 and 27 of 30): the take-off budget holds the take-off's
+    // work there (docs/decisions/0046), so the gaps do not depend on the machine's speed;
+    // a re-plan's cuts still do (c3-0013 meets the criteria in some runs, not others).
     let meeting = r.outcomes.iter().filter(|o| o.meets_criteria()).count();
     let within = r
         .outcomes
@@ -116,7 +117,7 @@ fn a_ci_sized_campaign_meets_its_bars_and_four_merged_shards_give_its_outcomes()
         "{meeting} of {COUNT} meet the criteria\n{report_md}"
     );
     assert!(
-        within >= 21,
+        within >= 25,
         "{within} of {COUNT} within 0.5 %\n{report_md}"
     );
     let passes = meeting as f64 >= 0.99 * COUNT as f64 && within as f64 >= 0.98 * COUNT as f64;

@@ -42,12 +42,19 @@ pub struct ServiceConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BudgetConfig {
-    /// Deadline of a 2-D plan made from scratch, ms: the take-off plan, a new tasking, a
-    /// restart (nothing in flight to start from). A plan commits this long after it
-    /// starts (mission time when it is started, which is later than its trigger if the
-    /// compute gate deferred it).
+    /// Deadline of a 2-D take-off plan (trigger `Initial`), ms. The aircraft waits at the
+    /// tasking's start for it, so it costs no mission time: long enough that the global
+    /// search and its wave run to their end on a slow flight computer, and the take-off
+    /// plan is the same on any computer that holds it.
+    pub takeoff_2d_ms: u64,
+    /// Deadline of a 3-D take-off plan, ms.
+    pub takeoff_3d_ms: u64,
+    /// Deadline of a 2-D plan made from scratch in flight, ms: a new tasking, a restart
+    /// (nothing in flight to start from). A plan commits this long after it starts
+    /// (mission time when it is started, which is later than its trigger if the compute
+    /// gate deferred it).
     pub plan_2d_ms: u64,
-    /// Deadline of a 3-D plan made from scratch, ms.
+    /// Deadline of a 3-D plan made from scratch in flight, ms.
     pub plan_3d_ms: u64,
     /// Deadline of a 2-D re-plan of the plan in flight (a pop-up, a moving threat's
     /// scheduled re-plan, a deviation, a lead-route change, an expiry), ms: the
@@ -72,7 +79,9 @@ pub struct BudgetConfig {
 impl BudgetConfig {
     /// The largest of the budgets, ms.
     pub fn largest_ms(&self) -> u64 {
-        self.plan_2d_ms
+        self.takeoff_2d_ms
+            .max(self.takeoff_3d_ms)
+            .max(self.plan_2d_ms)
             .max(self.plan_3d_ms)
             .max(self.replan_2d_ms)
             .max(self.replan_3d_ms)
@@ -182,6 +191,8 @@ impl Default for ServiceConfig {
 impl Default for BudgetConfig {
     fn default() -> Self {
         BudgetConfig {
+            takeoff_2d_ms: 2000,
+            takeoff_3d_ms: 2500,
             plan_2d_ms: 500,
             plan_3d_ms: 2500,
             replan_2d_ms: 100,
@@ -283,23 +294,19 @@ impl ServiceConfig {
             return bad("vehicle_id", e.to_string());
         }
         let b = &self.budget;
-        if b.plan_2d_ms == 0 {
-            return bad("budget.plan_2d_ms", "must be positive".into());
-        }
-        if b.plan_3d_ms == 0 {
-            return bad("budget.plan_3d_ms", "must be positive".into());
-        }
-        if b.replan_2d_ms == 0 {
-            return bad("budget.replan_2d_ms", "must be positive".into());
-        }
-        if b.replan_3d_ms == 0 {
-            return bad("budget.replan_3d_ms", "must be positive".into());
-        }
-        if b.refine_2d_ms == 0 {
-            return bad("budget.refine_2d_ms", "must be positive".into());
-        }
-        if b.refine_3d_ms == 0 {
-            return bad("budget.refine_3d_ms", "must be positive".into());
+        for (key, ms) in [
+            ("budget.takeoff_2d_ms", b.takeoff_2d_ms),
+            ("budget.takeoff_3d_ms", b.takeoff_3d_ms),
+            ("budget.plan_2d_ms", b.plan_2d_ms),
+            ("budget.plan_3d_ms", b.plan_3d_ms),
+            ("budget.replan_2d_ms", b.replan_2d_ms),
+            ("budget.replan_3d_ms", b.replan_3d_ms),
+            ("budget.refine_2d_ms", b.refine_2d_ms),
+            ("budget.refine_3d_ms", b.refine_3d_ms),
+        ] {
+            if ms == 0 {
+                return bad(key, "must be positive".into());
+            }
         }
         if self.solver.threads == 0 {
             return bad("solver.threads", "must be at least 1".into());
@@ -386,7 +393,15 @@ impl ServiceConfig {
         Ok(())
     }
 
-    /// Compute budget of one plan of `model` made from scratch.
+    /// Compute budget of the take-off plan of `model`.
+    pub fn takeoff_budget(&self, model: Model) -> Duration {
+        Duration::from_millis(match model {
+            Model::TwoD => self.budget.takeoff_2d_ms,
+            Model::ThreeD => self.budget.takeoff_3d_ms,
+        })
+    }
+
+    /// Compute budget of one plan of `model` made from scratch in flight.
     pub fn plan_budget(&self, model: Model) -> Duration {
         Duration::from_millis(match model {
             Model::TwoD => self.budget.plan_2d_ms,

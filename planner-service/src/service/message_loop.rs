@@ -63,7 +63,7 @@ use wingman_interfaces::{
 use super::budget::{ComputeGate, GateSettings};
 use super::run::{RunOptions, ServiceError};
 use super::solver::Solver;
-use super::triggers::{self, TriggerSet};
+use super::triggers::{self, BudgetKind, TriggerSet};
 use super::world::World;
 use inputs::Logged;
 use lifecycle::{FirstPlan, PlanLifecycle};
@@ -325,8 +325,8 @@ impl MessageLoop {
         self.has_plan && !triggers::from_scratch(set)
     }
 
-    /// Budget of a plan of the current tasking's model for the triggers `set`: a re-plan
-    /// of the plan in flight's, a refinement's, or a plan from scratch's.
+    /// Budget of a plan of the current tasking's model for the triggers `set`: the
+    /// take-off plan's, a plan from scratch's, a refinement's or a re-plan's.
     fn budget(&self, set: TriggerSet) -> Duration {
         let model = self
             .world
@@ -334,12 +334,11 @@ impl MessageLoop {
             .as_ref()
             .and_then(Tasking::model)
             .unwrap_or(Model::ThreeD);
-        if !self.replans_in_flight(set) {
-            self.cfg.plan_budget(model)
-        } else if triggers::refine_only(set) || triggers::refines_deviation(set) {
-            self.cfg.refine_budget(model)
-        } else {
-            self.cfg.replan_budget(model)
+        match triggers::budget_kind(set, self.has_plan) {
+            BudgetKind::TakeOff => self.cfg.takeoff_budget(model),
+            BudgetKind::FromScratch => self.cfg.plan_budget(model),
+            BudgetKind::Refine => self.cfg.refine_budget(model),
+            BudgetKind::Replan => self.cfg.replan_budget(model),
         }
     }
 }

@@ -446,6 +446,33 @@ pub fn from_scratch(set: TriggerSet) -> bool {
         .any(|&t| set.contains(t))
 }
 
+/// Which of the configured budgets a plan takes (`[budget]` in `planner.toml`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BudgetKind {
+    /// The take-off plan: the aircraft waits at the tasking's start for it.
+    TakeOff,
+    /// A plan from scratch in flight: a new tasking, a restart, or no plan to re-plan.
+    FromScratch,
+    /// A refinement of a plan short of `Optimal` (a deviation's included).
+    Refine,
+    /// A re-plan of the plan in flight: the aircraft's reaction time.
+    Replan,
+}
+
+/// The budget of a plan for the triggers `set`, `has_plan` saying whether a plan is in
+/// flight.
+pub fn budget_kind(set: TriggerSet, has_plan: bool) -> BudgetKind {
+    if set.contains(Trigger::Initial) {
+        BudgetKind::TakeOff
+    } else if !has_plan || from_scratch(set) {
+        BudgetKind::FromScratch
+    } else if refine_only(set) || refines_deviation(set) {
+        BudgetKind::Refine
+    } else {
+        BudgetKind::Replan
+    }
+}
+
 /// Whether a re-plan for the pending triggers `set` starts from the ownship's state rather
 /// than from the state the current plan predicts: the aircraft left the plan (a deviation
 /// or a restart is pending, whatever trigger names the plan) or flies a safe hold.

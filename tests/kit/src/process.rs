@@ -178,14 +178,16 @@ pub fn planner(config: &Path, vehicle: &str, log: &Path) -> Proc {
     Proc::spawn(c, "wingman-planner serve")
 }
 
-/// Writes a planner configuration: the given budgets, a 100 ms heartbeat, no duty-cycle
-/// cap beyond one core over a minute, and `extra` TOML lines.
+/// Writes a planner configuration: the given budgets (for the take-off plan, plans from
+/// scratch and re-plans alike), a 100 ms heartbeat, no duty-cycle cap beyond one core over
+/// a minute, and `extra` TOML lines.
 pub fn planner_config(dir: &Path, plan_2d_ms: u64, plan_3d_ms: u64, extra: &str) -> PathBuf {
     let p = dir.join("planner.toml");
     std::fs::write(
         &p,
         format!(
-            "[budget]\nplan_2d_ms = {plan_2d_ms}\nplan_3d_ms = {plan_3d_ms}\n\
+            "[budget]\ntakeoff_2d_ms = {plan_2d_ms}\ntakeoff_3d_ms = {plan_3d_ms}\n\
+             plan_2d_ms = {plan_2d_ms}\nplan_3d_ms = {plan_3d_ms}\n\
              replan_2d_ms = {plan_2d_ms}\nreplan_3d_ms = {plan_3d_ms}\nduty_cycle = 1.0\n\
              duty_window_ms = 60000\n\n[status]\nheartbeat_ms = 100\n{extra}"
         ),
