@@ -358,7 +358,7 @@ fn gather<'a>(
         let current_optimal = current.quality == Quality::Optimal;
         let next = if round == 0 {
             round_result.take()
-        } else if current.quality != Quality::Optimal
+        } else if !current_optimal
             || deadline
                 .at(Work::Refinement)
                 .cuts(round as u32, Deadline::expired)

@@ -322,7 +322,7 @@ impl MessageLoop {
     /// and the triggers leave something of it to start from (not a first plan, a new
     /// tasking or a restart).
     fn replans_in_flight(&self, set: TriggerSet) -> bool {
-        self.has_plan && !triggers::from_scratch(set)
+        triggers::replans_in_flight(set, self.has_plan)
     }
 
     /// Budget of a plan of the current tasking's model for the triggers `set`: the

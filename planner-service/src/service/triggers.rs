@@ -446,6 +446,13 @@ pub fn from_scratch(set: TriggerSet) -> bool {
         .any(|&t| set.contains(t))
 }
 
+/// Whether a plan for the triggers `set` re-plans the plan in flight: there is one
+/// (`has_plan`), and the triggers leave something of it to start from (not a first plan,
+/// a new tasking or a restart).
+pub fn replans_in_flight(set: TriggerSet, has_plan: bool) -> bool {
+    has_plan && !from_scratch(set)
+}
+
 /// Which of the configured budgets a plan takes (`[budget]` in `planner.toml`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BudgetKind {
@@ -464,7 +471,7 @@ pub enum BudgetKind {
 pub fn budget_kind(set: TriggerSet, has_plan: bool) -> BudgetKind {
     if set.contains(Trigger::Initial) {
         BudgetKind::TakeOff
-    } else if !has_plan || from_scratch(set) {
+    } else if !replans_in_flight(set, has_plan) {
         BudgetKind::FromScratch
     } else if refine_only(set) || refines_deviation(set) {
         BudgetKind::Refine
