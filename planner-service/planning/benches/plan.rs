@@ -105,6 +105,7 @@ fn main() {
     // campaign measures what they find.
     let settings = PlannerSettings {
         wave_starts: 0,
+        wave_starts_3d: 0,
         ..PlannerSettings::default()
     };
     let scenarios: Vec<(&str, Problem)> = BUNDLED

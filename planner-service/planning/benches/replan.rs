@@ -210,6 +210,7 @@ fn main() {
     // when this bench's numbers were taken): the re-plans are what it measures.
     let settings = PlannerSettings {
         wave_starts: 0,
+        wave_starts_3d: 0,
         ..PlannerSettings::default()
     };
     let kkt = Arc::new(KktCache::new());

@@ -284,6 +284,9 @@ struct Gathered {
     cut: bool,
     /// When (stage clock) the first `Optimal` solution of a final or a round was there.
     first_optimal: Option<Duration>,
+    /// The NLP work done: each solve's iterations times its mesh's intervals, summed.
+    /// Counted, not timed, so the same on any computer (the waves' gate, `waves`).
+    work: usize,
 }
 
 /// The schedule's results in the step-by-step order (ranks, finals, rounds) into the
@@ -308,12 +311,14 @@ fn gather<'a>(
     let failed = || Ok((None, 0, NlpStatus::NumericalError, SolveTiming::default()));
     // A rank the deadline stopped: the ranking was cut short.
     let mut cut = false;
-    for r in done.ranks {
+    let mut work = 0;
+    for (r, coarse) in done.ranks.into_iter().zip(stage.coarse) {
         let (path, result) = match r {
             Some(Ranked { result, path }) => (path, result),
             None => (None, failed()),
         };
         let (_, iterations, status, _) = result?;
+        work += iterations * coarse.intervals();
         cut |= status == NlpStatus::MaxTime;
         report.iterations.push(iterations);
         report.status = Some(status);
@@ -337,6 +342,7 @@ fn gather<'a>(
             None => (failed(), None, Duration::ZERO),
         };
         let (solved, iterations, status, _) = result?;
+        work += iterations * fine.as_ref().map_or(0, Mesh::intervals);
         report.iterations.push(iterations);
         report.status = Some(status);
         optimal_at(solved.as_ref(), done_at);
@@ -371,6 +377,7 @@ fn gather<'a>(
             break;
         };
         let (solved, iterations, status, _) = result?;
+        work += iterations * next.intervals();
         report.iterations.push(iterations);
         report.status = Some(status);
         optimal_at(solved.as_ref(), done_at);
@@ -394,6 +401,7 @@ fn gather<'a>(
         accepted,
         cut,
         first_optimal,
+        work,
     })
 }
 

@@ -100,6 +100,7 @@ fn waves_rank_further_starts_and_never_lose_the_global_searchs_plan() {
             };
             let alone = PlannerSettings {
                 wave_starts: 0,
+                wave_starts_3d: 0,
                 ..settings.clone()
             };
             let plan = |s: &PlannerSettings| {
@@ -128,6 +129,54 @@ fn waves_rank_further_starts_and_never_lose_the_global_searchs_plan() {
     }
     assert!(!a_wave_won.is_empty(), "no wave's start won on any mission");
     println!("a wave won: {a_wave_won:?}");
+}
+
+/// The work cap (`wave_work`), not the clock, decides how many waves a 2-D plan runs:
+/// with a cap of 0 none runs (the plan is the global search's alone, bit for bit); with
+/// no deadline the default cap stops the waves short of all their starts (which run with
+/// no cap: 45 ranks here against 30), and a 60 s deadline runs the same plan as none.
+#[test]
+fn the_work_cap_decides_how_many_waves_a_plan_runs() {
+    let name = "2d-fixed-time-unavoidable";
+    let (problem, defaults, _) = fresh(name);
+    let plan = |s: &PlannerSettings, deadline: Deadline<'static>| {
+        Planner::new(s).plan(&problem, s, deadline).unwrap()
+    };
+    let with = |wave_work: Option<usize>| PlannerSettings {
+        wave_work,
+        ..defaults.clone()
+    };
+    let alone = PlannerSettings {
+        wave_starts: 0,
+        ..defaults.clone()
+    };
+    let never = || Deadline::never(clock());
+    let no_room = plan(&with(Some(0)), never());
+    let global = plan(&alone, never());
+    assert_eq!(no_room.nlp.ranking.len(), defaults.starts);
+    assert_eq!(bits(&no_room.trajectory), bits(&global.trajectory));
+
+    let capped = plan(&defaults, never());
+    let uncapped = plan(&with(None), never());
+    let ranks = |o: &wingman_planning::hybrid::PlanOutcome| o.nlp.ranking.len();
+    println!(
+        "{name}: ranks {} capped, {} uncapped",
+        ranks(&capped),
+        ranks(&uncapped)
+    );
+    assert!(
+        ranks(&capped) > defaults.starts,
+        "no wave ran under the cap"
+    );
+    assert!(
+        ranks(&capped) < ranks(&uncapped),
+        "the cap stopped no wave: {} ranks, {} with no cap",
+        ranks(&capped),
+        ranks(&uncapped)
+    );
+    let timed = plan(&defaults, Deadline::after(clock(), Duration::from_secs(60)));
+    assert_eq!(bits(&timed.trajectory), bits(&capped.trajectory));
+    assert_eq!(timed.nlp.ranking.len(), ranks(&capped));
 }
 
 #[test]

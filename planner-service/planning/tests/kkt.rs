@@ -20,14 +20,18 @@ use counting_alloc::allocations_in;
 use wingman_testkit::counting_alloc;
 
 mod common;
-use common::{clock, planned, transcribed};
+use common::{clock, planned_globally, transcribed};
 
-/// Cold solves of `name` on a 5-point mesh from the hybrid planner's plan, with FERAL and
-/// with the structured backend: both converge, to the same objective within 1e-5 of it
-/// (the solves take different pivots, so their iterates differ by rounding, and both stop
-/// at `tol` 1e-7 on the scaled problem), and the structured one used block elimination.
+/// Cold solves of `name` on a 5-point mesh from the plan of the hybrid planner's global
+/// search, with FERAL and with the structured backend: both converge, to the same
+/// objective within 1e-5 of it (the solves take different pivots, so their iterates
+/// differ by rounding, and both stop at `tol` 1e-7 on the scaled problem), and the
+/// structured one used block elimination. (From the waves' slightly better plan of
+/// `2d-fixed-time-unavoidable` the two coarse solves, rounding apart, end in two local
+/// minima of the coarse problem, 60.48 and 55.59: a fact of the non-convex problem, not
+/// of either backend, so the guess is the global search's.)
 fn same_objective(name: &str) {
-    let (p, guess) = planned(name);
+    let (p, guess) = planned_globally(name);
     let mesh = Mesh::uniform(5, &phase_durations(p.t0, &guess), 35.0, 2);
     let mut objective = [0.0; 2];
     for (slot, kkt) in [KktSolver::Feral, KktSolver::Structured]
@@ -181,7 +185,7 @@ fn triplets(entries: &[(usize, usize, Entry)]) -> (Vec<i32>, Vec<i32>) {
 /// rendezvous rows); then factorising and solving again and again (two right-hand sides)
 /// allocates nothing.
 fn labels_fit_and_do_not_allocate(name: &str) {
-    let (p, guess) = planned(name);
+    let (p, guess) = planned_globally(name);
     let mesh = Mesh::uniform(5, &phase_durations(p.t0, &guess), 35.0, 2);
     let tr = Transcription::new(&p, &mesh, &guess, &TranscriptionSettings::default());
     let labels = KktLabels::of(&tr);
@@ -249,7 +253,7 @@ fn factorise_and_solve_do_not_allocate_3d() {
 /// nonzero for the driven one, at random states and controls).
 fn groups_are_the_nodes_controls_and_driven_rows(name: &str) {
     use rand::{RngExt, SeedableRng};
-    let (p, guess) = planned(name);
+    let (p, guess) = planned_globally(name);
     let mesh = Mesh::uniform(5, &phase_durations(p.t0, &guess), 35.0, 2);
     let (tr, _) = transcribed(&p, &mesh, &guess);
     let labels = KktLabels::of(&tr);
@@ -308,7 +312,7 @@ fn pivot_groups_3d() {
 fn surplus_stops_agree_with_the_eigenvalues(name: &str) {
     use nalgebra::{DMatrix, SymmetricEigen};
     use rand::{RngExt, SeedableRng};
-    let (p, guess) = planned(name);
+    let (p, guess) = planned_globally(name);
     let mesh = Mesh::uniform(4, &phase_durations(p.t0, &guess), 120.0, 3);
     let tr = Transcription::new(&p, &mesh, &guess, &TranscriptionSettings::default());
     let (dim, m, entries) = kkt_pattern(&tr);

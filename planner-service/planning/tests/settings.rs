@@ -126,11 +126,18 @@ fn a_plan_with_bad_settings_fails_before_it_starts() {
 /// yardstick's (no waves) pass.
 #[test]
 fn bad_wave_settings_are_refused_by_name() {
-    let cases: [(&str, PlannerSettings); 5] = [
+    let cases: [(&str, PlannerSettings); 6] = [
         (
             "wave_starts",
             PlannerSettings {
                 wave_starts: 201,
+                ..PlannerSettings::default()
+            },
+        ),
+        (
+            "wave_starts_3d",
+            PlannerSettings {
+                wave_starts_3d: 201,
                 ..PlannerSettings::default()
             },
         ),

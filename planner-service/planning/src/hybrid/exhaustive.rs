@@ -78,6 +78,7 @@ impl PlannerSettings {
         s.starts = 24;
         // Its own search stays as it was measured: no waves after it.
         s.wave_starts = 0;
+        s.wave_starts_3d = 0;
         s.start_ranking = StartRanking::Both;
         s.finalists = 6;
         s.finalist_gap_tol = 0.5;

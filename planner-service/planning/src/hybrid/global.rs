@@ -112,9 +112,17 @@ impl Planner {
             accepted,
             cut,
             first_optimal,
+            ..
         } = if widen && !no_time {
             let took = clock.now().saturating_sub(nlp_started);
-            let waves = Waves::new(problem, settings, &starts, &sw.best, timing, took);
+            let waves = Waves::new(
+                problem,
+                settings,
+                &starts,
+                &sw.best,
+                timing,
+                (took, gathered.work),
+            );
             self.waves(waves, deadline.no_later_than(&waves_deadline), gathered)?
         } else {
             gathered

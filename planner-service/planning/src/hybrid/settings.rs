@@ -50,10 +50,18 @@ pub struct PlannerSettings {
     /// NLP starts from distinct basins: the swarm's best and the best seeds that pass some
     /// threat on another side (see `basins`).
     pub starts: usize,
-    /// A plan from scratch may solve starts up to this many in all: after its global
-    /// search, while time is left, the next `starts` of them at a time (a wave,
-    /// `hybrid::waves`); `starts` or fewer: no waves.
+    /// A 2-D plan from scratch may solve starts up to this many in all: after its global
+    /// search, while its work and time allow, the next `starts` of them at a time (a
+    /// wave, `hybrid::waves`); `starts` or fewer: no waves.
     pub wave_starts: usize,
+    /// The same in 3-D.
+    pub wave_starts_3d: usize,
+    /// A wave of a 2-D plan starts only if the plan's NLP work so far and the last
+    /// stage's again stay within this many units (a solve's iterations times its mesh's
+    /// intervals: counted, so the same on any computer); `None`: no limit but the clock.
+    pub wave_work: Option<usize>,
+    /// The same in 3-D.
+    pub wave_work_3d: Option<usize>,
     /// The seeds the waves' starts are drawn from (built by the first wave).
     pub wave_seeds: SeedSettings,
     /// How the waves' starts are ranked (a fixed-time plan's; see `basins::candidates`):
@@ -142,9 +150,14 @@ impl Default for PlannerSettings {
             swarm_share: 0.3,
             starts: 5, // six's worst cost, a 16 % shorter ranking; four lose basins (0021)
             start_ranking: StartRanking::OnTimeFirst,
-            // One wave: with four, the clock chose the course of 405 of 500 take-off
-            // plans; one fits the budget on most missions (0040).
-            wave_starts: 10,
+            // 2-D: waves while 40 000 units of work hold them, which fit the take-off
+            // budget at half the usual speed, so that the work, not the clock, decides
+            // how many run (0048). 3-D: one wave, within half the budget (0040); a 3-D
+            // unit takes 2-4 times as long, and a cap that fits leaves no wave.
+            wave_starts: 25,
+            wave_starts_3d: 10,
+            wave_work: Some(40_000),
+            wave_work_3d: None,
             // The yardstick's wider bulges and random curves (0040).
             wave_seeds: SeedSettings::default()
                 .with_bulge_ratios(&[0.15, 0.3, 0.5, 0.8, 1.2])
@@ -230,9 +243,14 @@ impl PlannerSettings {
             // A start's index names its solves' deadline cuts in 8 bits (`cuts::Work`).
             return out("starts", "must be in 1..=200");
         }
-        if self.wave_starts > 200 {
-            // Each wave names its cuts' part in 8 bits (`cuts::Part::Wave`).
-            return out("wave_starts", "must be at most 200");
+        for (setting, value) in [
+            ("wave_starts", self.wave_starts),
+            ("wave_starts_3d", self.wave_starts_3d),
+        ] {
+            if value > 200 {
+                // Each wave names its cuts' part in 8 bits (`cuts::Part::Wave`).
+                return out(setting, "must be at most 200");
+            }
         }
         for (setting, value) in [
             ("wave_share", self.wave_share),

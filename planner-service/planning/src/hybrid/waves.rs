@@ -1,20 +1,22 @@
-//! Waves: a plan from scratch that has time left after its global search solves the next
-//! starts from distinct basins, `starts` at a time, up to `wave_starts` in all (one wave of
-//! five by default).
+//! Waves: a plan from scratch that has work and time left after its global search solves
+//! the next starts from distinct basins, `starts` at a time, up to `wave_starts` in all
+//! (`wave_starts_3d` in 3-D).
 //!
 //! The global search ranks a few starts (five) and solves the best of them; on missions
 //! nobody tuned for, the best basin is sometimes the sixth or the tenth start
-//! (`docs/decisions/0040`). A plan commits at its deadline whatever time it used, so the
-//! time a plan from scratch leaves is spent on the next starts: each wave ranks its starts
-//! on the coarse mesh, solves on the working mesh only those ranked within
-//! `wave_gap_tol` of the best ranked so far, and its winner replaces the plan if it is
-//! better (an `Optimal` solution before any other, then the lower objective).
+//! (`docs/decisions/0040`). Each wave ranks its starts on the coarse mesh, solves on the
+//! working mesh only those ranked within `wave_gap_tol` of the best ranked so far, and
+//! its winner replaces the plan if it is better (an `Optimal` solution before any other,
+//! then the lower objective).
 //!
-//! A wave starts only if the time left holds a stage as long as the last one took; that
-//! choice is a deadline cut (`Part::Wave(k)`, `Work::Whole`), so a replay runs the same
-//! waves. With no deadline every wave runs. The count is fixed and sized to fit the budget
-//! on most missions: the clock guards it, it does not decide it, so most take-off plans
-//! stay functions of their inputs alone.
+//! Two gates, both asked before each wave:
+//! - **Work** (`wave_work`, `wave_work_3d`): the plan's NLP work so far, plus the last
+//!   stage's again (the wave's estimate), must stay within the cap. Work is counted (a
+//!   solve's iterations times its mesh's intervals), so this gate is the same on any
+//!   computer: it decides how many waves a plan runs (`docs/decisions/0048`).
+//! - **Time**: the time left must hold a stage as long as the last one took. That choice
+//!   is a deadline cut (`Part::Wave(k)`, `Work::Whole`), so a replay runs the same waves;
+//!   it guards a slow or loaded computer. With no deadline only the work decides.
 
 use std::time::Duration;
 
@@ -44,18 +46,21 @@ pub(super) struct Waves<'a> {
     timing: SolveTiming,
     /// How long the global search's NLP stage took.
     stage_took: Duration,
+    /// How much work it did (see [`Gathered::work`]).
+    stage_work: usize,
 }
 
 impl<'a> Waves<'a> {
     /// The waves after the global search of `problem`: its starts `taken`, the swarm's
-    /// best, the solves' timing, and how long its NLP stage took.
+    /// best, the solves' timing, and how long its NLP stage took and how much work it
+    /// did.
     pub fn new(
         problem: &'a Problem,
         settings: &'a PlannerSettings,
         taken: &'a [Trajectory],
         swarm_best: &'a Trajectory,
         timing: SolveTiming,
-        stage_took: Duration,
+        (stage_took, stage_work): (Duration, usize),
     ) -> Waves<'a> {
         Waves {
             problem,
@@ -64,6 +69,7 @@ impl<'a> Waves<'a> {
             swarm_best,
             timing,
             stage_took,
+            stage_work,
         }
     }
 }
@@ -83,6 +89,16 @@ pub(super) fn deadline(
     deadline.share(share)
 }
 
+/// The most starts a plan of `problem` solves in all, its global search's included, and
+/// the cap on its NLP work before a wave (`None`: none).
+fn limits(problem: &Problem, settings: &PlannerSettings) -> (usize, Option<usize>) {
+    if problem.dim() == 3 {
+        (settings.wave_starts_3d, settings.wave_work_3d)
+    } else {
+        (settings.wave_starts, settings.wave_work)
+    }
+}
+
 impl Planner {
     /// Runs the waves while the deadline holds them; `best` (the global search's result)
     /// comes back with every wave's ranks and iterations appended, its accepted solution
@@ -100,8 +116,10 @@ impl Planner {
             swarm_best,
             timing,
             mut stage_took,
+            mut stage_work,
         } = waves;
-        if settings.wave_starts <= settings.starts {
+        let (most_starts, work_cap) = limits(problem, settings);
+        if most_starts <= settings.starts {
             return Ok(best);
         }
         let clock = deadline.clock();
@@ -116,6 +134,9 @@ impl Planner {
             let Some(bar) = best_rank(&best) else {
                 break;
             };
+            if work_cap.is_some_and(|cap| best.work + stage_work > cap) {
+                break;
+            }
             let part = Part::Wave(u8::try_from(k + 1).unwrap_or(u8::MAX));
             let deadline = deadline.within(part);
             if deadline.cuts(0, |d| d.remaining() < stage_took) {
@@ -123,7 +144,7 @@ impl Planner {
             }
             let started = clock.now();
             if k == 0 {
-                later = wave_starts(problem, settings, taken, swarm_best, deadline)?;
+                later = wave_starts(problem, settings, most_starts, taken, swarm_best, deadline)?;
             }
             let Some(wave_starts) = later.chunks(size).nth(k) else {
                 break;
@@ -146,17 +167,20 @@ impl Planner {
             let done = schedule::run(&stage, settings.threads);
             let wave = gather(&stage, done, deadline)?;
             stage_took = clock.now().saturating_sub(started);
+            stage_work = wave.work;
             merge(&mut best, wave, taken.len() + k * size);
         }
         Ok(best)
     }
 }
 
-/// The waves' starts, in order: built by the first wave from the wider seeds
-/// (`wave_seeds` with the swarm's random stream, under its deadline), distinct from the global search's.
+/// The waves' starts, in order, up to `most` with the global search's: built by the first
+/// wave from the wider seeds (`wave_seeds` with the swarm's random stream, under its
+/// deadline), distinct from the global search's.
 fn wave_starts(
     problem: &Problem,
     settings: &PlannerSettings,
+    most: usize,
     taken: &[Trajectory],
     swarm_best: &Trajectory,
     deadline: Deadline<'static>,
@@ -181,7 +205,7 @@ fn wave_starts(
         problem,
         taken,
         &seeds,
-        settings.wave_starts,
+        most,
         settings.threads,
         settings.wave_ranking,
         |tr| trajectory_cost(problem, tr),
@@ -201,7 +225,7 @@ fn best_rank(best: &Gathered) -> Option<f64> {
         .min_by(f64::total_cmp)
 }
 
-/// `wave`'s ranks and iterations appended to `best`'s report; its solution taken if better
+/// `wave`'s ranks, iterations and work added to `best`'s; its solution taken if better
 /// (its finalists then named by their index among all starts, the wave's first being
 /// `offset`).
 fn merge(best: &mut Gathered, wave: Gathered, offset: usize) {
@@ -220,6 +244,7 @@ fn merge(best: &mut Gathered, wave: Gathered, offset: usize) {
         best.report.finalists = wave.report.finalists.iter().map(|c| c + offset).collect();
     }
     best.first_optimal = best.first_optimal.or(wave.first_optimal);
+    best.work += wave.work;
 }
 
 /// Whether `a` beats `b`: `Optimal` before any other quality, then the lower objective

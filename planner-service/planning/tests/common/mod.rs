@@ -28,12 +28,28 @@ pub fn planned(name: &str) -> (Problem, Trajectory) {
 
 /// The problem of bundled scenario `name` and the planner's plan for it.
 pub fn planned_outcome(name: &str) -> (Problem, PlanOutcome) {
+    planned_with(name, &PlannerSettings::default())
+}
+
+/// The problem of bundled scenario `name` and the plan of its global search alone (no
+/// waves of further starts): the guess the collocation tests were written on.
+pub fn planned_globally(name: &str) -> (Problem, Trajectory) {
+    let settings = PlannerSettings {
+        wave_starts: 0,
+        wave_starts_3d: 0,
+        ..PlannerSettings::default()
+    };
+    let (p, plan) = planned_with(name, &settings);
+    (p, plan.trajectory)
+}
+
+/// The problem of bundled scenario `name` and the plan `settings` make for it.
+fn planned_with(name: &str, settings: &PlannerSettings) -> (Problem, PlanOutcome) {
     let p = Problem::from_scenario(&bundled(name).unwrap().unwrap()).unwrap();
-    let settings = PlannerSettings::default();
-    let plan = Planner::new(&settings)
+    let plan = Planner::new(settings)
         .plan(
             &p,
-            &settings,
+            settings,
             Deadline::after(clock(), Duration::from_secs(60)),
         )
         .unwrap();
