@@ -447,8 +447,8 @@ pub fn phase_durations(t0: f64, tr: &Trajectory) -> Vec<f64> {
 }
 
 /// Farthest the exported plan's end may lie from where its problem wants it (the final
-/// point, or the lead at the plan's final time) for the plan to keep its NLP solution's
-/// `Optimal`, m. The NLP meets its end to its tolerance, but a 3-D plan is exported as its
+/// point, or the lead at the plan's final time), and farthest it may pass from a target,
+/// for the plan to keep its NLP solution's `Optimal`, m. The NLP meets its end to its tolerance, but a 3-D plan is exported as its
 /// path flown by the tracking law, and a path the working mesh resolves too coarsely (its
 /// refinement round cut by the deadline) can be flown hundreds of metres off: a 3-D
 /// rendezvous re-planned for a lead's new route ended 743 m from the lead. Exports of
@@ -461,20 +461,55 @@ pub fn end_miss_m(problem: &Problem, tr: &Trajectory) -> f64 {
         return f64::INFINITY;
     };
     let (at, wanted) = (problem.position(state), problem.final_position_at(t));
+    distance(&at, &wanted, problem.dim())
+}
+
+/// How far `tr` passes from the target of `problem` it passes farthest from, m (0 with no
+/// target): for each target the closest approach of the path, taken as straight between
+/// its samples (0.5 s apart, up to 130 m at 3-D speeds), in the horizontal plane in 2-D.
+pub fn target_miss_m(problem: &Problem, tr: &Trajectory) -> f64 {
     let dims = problem.dim();
-    at.iter()
-        .zip(wanted)
-        .take(dims)
-        .map(|(a, b)| (a - b) * (a - b))
+    let at: Vec<[f64; 3]> = tr.states.iter().map(|s| problem.position(s)).collect();
+    let closest = |target: &[f64; 3]| {
+        if let [only] = at.as_slice() {
+            return distance(only, target, dims);
+        }
+        at.windows(2)
+            .map(|ab| segment_distance(&ab[0], &ab[1], target, dims))
+            .fold(f64::INFINITY, f64::min)
+    };
+    problem.targets.iter().map(closest).fold(0.0, f64::max)
+}
+
+/// The distance from `p` to the segment from `a` to `b`, in the first `dims` coordinates.
+fn segment_distance(a: &[f64; 3], b: &[f64; 3], p: &[f64; 3], dims: usize) -> f64 {
+    let along: f64 = (0..dims).map(|i| (p[i] - a[i]) * (b[i] - a[i])).sum();
+    let length2: f64 = (0..dims).map(|i| (b[i] - a[i]) * (b[i] - a[i])).sum();
+    let s = if length2 > 0.0 {
+        (along / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let on = [0, 1, 2].map(|i| a[i] + s * (b[i] - a[i]));
+    distance(&on, p, dims)
+}
+
+/// The distance between `a` and `b` in their first `dims` coordinates.
+fn distance(a: &[f64; 3], b: &[f64; 3], dims: usize) -> f64 {
+    (0..dims)
+        .map(|i| (a[i] - b[i]) * (a[i] - b[i]))
         .sum::<f64>()
         .sqrt()
 }
 
 /// The quality of `tr`, exported from an NLP solution of `quality`: an `Optimal` solution
-/// whose export misses its end by more than [`EXPORT_END_TOL_M`] is only `Feasible` (and
-/// the service refines it at once).
+/// whose export misses its end, or passes a target, farther than [`EXPORT_END_TOL_M`] is
+/// only `Feasible` (and the service refines it at once).
 pub(super) fn exported_quality(problem: &Problem, tr: &Trajectory, quality: Quality) -> Quality {
-    if quality == Quality::Optimal && end_miss_m(problem, tr) > EXPORT_END_TOL_M {
+    if quality == Quality::Optimal
+        && (end_miss_m(problem, tr) > EXPORT_END_TOL_M
+            || target_miss_m(problem, tr) > EXPORT_END_TOL_M)
+    {
         Quality::Feasible
     } else {
         quality
@@ -513,6 +548,14 @@ pub fn trajectory_cost(problem: &Problem, tr: &Trajectory) -> f64 {
 mod tests {
     use super::*;
 
+    /// The problem of the bundled `2d-min-time-avoidable` (one target).
+    fn min_time_avoidable() -> Problem {
+        let sc = crate::scenario::bundled("2d-min-time-avoidable")
+            .unwrap()
+            .unwrap();
+        Problem::from_scenario(&sc).unwrap()
+    }
+
     /// A straight 2-D path from `(0, y)` east at 200 m/s for 100 s.
     fn line(y: f64) -> Trajectory {
         let mut tr = Trajectory::default();
@@ -526,16 +569,16 @@ mod tests {
 
     /// An `Optimal` solution whose export ends more than 50 m from the final point is only
     /// `Feasible`; the miss is the horizontal distance in 2-D (the third state entry is
-    /// the heading), checked against the 3-4-5 triangle.
+    /// the heading), checked against the 3-4-5 triangle. (The path passes through the
+    /// target on a middle sample.)
     #[test]
     fn an_export_that_misses_its_end_is_not_optimal() {
-        let sc = crate::scenario::bundled("2d-min-time-avoidable")
-            .unwrap()
-            .unwrap();
-        let problem = Problem::from_scenario(&sc).unwrap();
-        let end = problem.final_position_at(0.0);
+        let problem = min_time_avoidable();
+        let (target, end) = (problem.targets[0], problem.final_position_at(0.0));
         let ending_at = |dx: f64, dy: f64| {
             let mut tr = line(0.0);
+            tr.states[5][0] = target[0];
+            tr.states[5][1] = target[1];
             let last = tr.states.len() - 1;
             tr.states[last][0] = end[0] + dx;
             tr.states[last][1] = end[1] + dy;
@@ -558,6 +601,37 @@ mod tests {
             Quality::Feasible
         );
         assert_eq!(end_miss_m(&problem, &Trajectory::default()), f64::INFINITY);
+    }
+
+    /// An `Optimal` solution whose export passes a target farther than 50 m is only
+    /// `Feasible`. The pass is the path's closest approach taken straight between its
+    /// samples: here midway between two samples 2 km apart and `d` abeam of the target, so
+    /// the miss is `d` (no sample comes nearer than 1 km); the path ends on the final point.
+    #[test]
+    fn an_export_that_passes_a_target_wide_is_not_optimal() {
+        let problem = min_time_avoidable();
+        let (target, end) = (problem.targets[0], problem.final_position_at(0.0));
+        let passing = |d: f64| {
+            let mut tr = Trajectory::default();
+            for (t, x, y) in [
+                (0.0, target[0] - 1000.0, target[1] + d),
+                (10.0, target[0] + 1000.0, target[1] + d),
+                (20.0, end[0], end[1]),
+            ] {
+                tr.push(t, [x, y, 0.0, 0.0, 0.0, 0.0, 0.0], [0.0; 2]);
+            }
+            tr.phase_ends = vec![5.0, 20.0];
+            tr
+        };
+        assert!((target_miss_m(&problem, &passing(40.0)) - 40.0).abs() < 1e-9);
+        assert!(end_miss_m(&problem, &passing(40.0)) < 1e-9);
+        let q = |tr: &Trajectory, q| exported_quality(&problem, tr, q);
+        assert_eq!(q(&passing(49.0), Quality::Optimal), Quality::Optimal);
+        assert_eq!(q(&passing(-51.0), Quality::Optimal), Quality::Feasible);
+        assert_eq!(
+            target_miss_m(&problem, &Trajectory::default()),
+            f64::INFINITY
+        );
     }
 
     #[test]
