@@ -142,8 +142,12 @@ def check_take_off(plan: c.Plan) -> None:
     )
     miss = math.hypot(last[0] - FINAL[0], last[1] - FINAL[1])
     check(miss < 100.0, f"it ends at the final point ({miss:.1f} m)")
-    # The deployment budget of a 2-D take-off plan is 500 ms, and the planner aims 20 ms early.
-    check(plan.compute_ms <= 500.0, f"within the 500 ms budget ({plan.compute_ms:.0f} ms)")
+    # The deployment budget of a 2-D take-off plan (`takeoff_2d_ms`, decision 0046) is
+    # 2000 ms, and the planner aims 20 ms early.
+    check(
+        plan.compute_ms <= 2000.0,
+        f"within the 2000 ms take-off budget ({plan.compute_ms:.0f} ms)",
+    )
 
 
 def fly(client: Client, plan, t_from: float, t_to: float):
