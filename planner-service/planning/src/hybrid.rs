@@ -448,8 +448,8 @@ pub fn phase_durations(t0: f64, tr: &Trajectory) -> Vec<f64> {
 
 /// Farthest the exported plan's end may lie from where its problem wants it (the final
 /// point, or the lead at the plan's final time), and farthest it may pass from a target,
-/// for the plan to keep its NLP solution's `Optimal`, m. The NLP meets its end to its tolerance, but a 3-D plan is exported as its
-/// path flown by the tracking law, and a path the working mesh resolves too coarsely (its
+/// for the plan to keep its NLP solution's `Optimal`, m. The NLP meets its end to its
+/// tolerance, but a 3-D plan is exported as its path flown by the tracking law, and a path the working mesh resolves too coarsely (its
 /// refinement round cut by the deadline) can be flown hundreds of metres off: a 3-D
 /// rendezvous re-planned for a lead's new route ended 743 m from the lead. Exports of
 /// converged plans end within a few metres.
@@ -468,14 +468,14 @@ pub fn end_miss_m(problem: &Problem, tr: &Trajectory) -> f64 {
 /// target): for each target the closest approach of the path, taken as straight between
 /// its samples (0.5 s apart, up to 130 m at 3-D speeds), in the horizontal plane in 2-D.
 pub fn target_miss_m(problem: &Problem, tr: &Trajectory) -> f64 {
-    let dims = problem.dim();
-    let at: Vec<[f64; 3]> = tr.states.iter().map(|s| problem.position(s)).collect();
+    let (dims, at) = (problem.dim(), |s: &[f64; 7]| problem.position(s));
     let closest = |target: &[f64; 3]| {
-        if let [only] = at.as_slice() {
-            return distance(only, target, dims);
+        if let [only] = tr.states.as_slice() {
+            return distance(&at(only), target, dims);
         }
-        at.windows(2)
-            .map(|ab| segment_distance(&ab[0], &ab[1], target, dims))
+        tr.states
+            .windows(2)
+            .map(|ab| segment_distance(&at(&ab[0]), &at(&ab[1]), target, dims))
             .fold(f64::INFINITY, f64::min)
     };
     problem.targets.iter().map(closest).fold(0.0, f64::max)

@@ -115,14 +115,7 @@ impl Planner {
             ..
         } = if widen && !no_time {
             let took = clock.now().saturating_sub(nlp_started);
-            let waves = Waves::new(
-                problem,
-                settings,
-                &starts,
-                &sw.best,
-                timing,
-                (took, gathered.work),
-            );
+            let waves = Waves::new(problem, settings, &starts, &sw.best, timing, took);
             self.waves(waves, deadline.no_later_than(&waves_deadline), gathered)?
         } else {
             gathered

@@ -46,21 +46,18 @@ pub(super) struct Waves<'a> {
     timing: SolveTiming,
     /// How long the global search's NLP stage took.
     stage_took: Duration,
-    /// How much work it did (see [`Gathered::work`]).
-    stage_work: usize,
 }
 
 impl<'a> Waves<'a> {
     /// The waves after the global search of `problem`: its starts `taken`, the swarm's
-    /// best, the solves' timing, and how long its NLP stage took and how much work it
-    /// did.
+    /// best, the solves' timing, and how long its NLP stage took.
     pub fn new(
         problem: &'a Problem,
         settings: &'a PlannerSettings,
         taken: &'a [Trajectory],
         swarm_best: &'a Trajectory,
         timing: SolveTiming,
-        (stage_took, stage_work): (Duration, usize),
+        stage_took: Duration,
     ) -> Waves<'a> {
         Waves {
             problem,
@@ -69,7 +66,6 @@ impl<'a> Waves<'a> {
             swarm_best,
             timing,
             stage_took,
-            stage_work,
         }
     }
 }
@@ -116,8 +112,9 @@ impl Planner {
             swarm_best,
             timing,
             mut stage_took,
-            mut stage_work,
         } = waves;
+        // The work of the last stage: the global search's, whose result `best` is.
+        let mut stage_work = best.work;
         let (most_starts, work_cap) = limits(problem, settings);
         if most_starts <= settings.starts {
             return Ok(best);
